@@ -1,0 +1,225 @@
+#include "trivox/spline/knot_vector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "trivox/error.hpp"
+
+namespace trivox::spline {
+
+namespace {
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+}  // namespace
+
+KnotVector::KnotVector(int order, std::vector<double> knots) : order_(order), knots_(std::move(knots)) {
+  if (order_ < 1)
+    throw Error("order " + std::to_string(order_) + "; expected an order (degree + 1) of at least 1");
+  const auto m = static_cast<int>(knots_.size());
+  if (m < 2 * order_)
+    throw Error(std::to_string(m) + " knots for order " + std::to_string(order_) +
+                "; expected at least " + std::to_string(2 * order_) +
+                " (control points + order, with at least order control points)");
+  for (int i = 0; i < m; ++i) {
+    if (!std::isfinite(knots_[i]))
+      throw Error("knot " + std::to_string(i) + " is " + num(knots_[i]) + "; expected a finite number");
+    if (i > 0 && knots_[i] < knots_[i - 1])
+      throw Error("knot " + std::to_string(i) + " is " + num(knots_[i]) + ", less than knot " +
+                  std::to_string(i - 1) + " (" + num(knots_[i - 1]) + "); expected non-decreasing knots");
+  }
+  if (!(front() < back()))
+    throw Error("empty domain [" + num(front()) + ", " + num(back()) + "]; expected knot " +
+                std::to_string(order_ - 1) + " < knot " + std::to_string(size()));
+  // Interior multiplicity above `order` would make a basis function identically zero.
+  for (int i = 0; i + order_ < m; ++i)
+    if (knots_[i] == knots_[i + order_])
+      throw Error("knot value " + num(knots_[i]) + " repeated more than " + std::to_string(order_) +
+                  " times from knot " + std::to_string(i) + "; expected multiplicity <= order");
+}
+
+KnotVector KnotVector::uniform(int order, int segments, double a, double b) {
+  if (segments < 1) throw Error("uniform knot vector with " + std::to_string(segments) + " segments; expected >= 1");
+  std::vector<double> k;
+  k.reserve(static_cast<std::size_t>(2 * order + segments - 1));
+  for (int i = 0; i < order; ++i) k.push_back(a);
+  for (int i = 1; i < segments; ++i) k.push_back(a + (b - a) * i / segments);
+  for (int i = 0; i < order; ++i) k.push_back(b);
+  return KnotVector(order, std::move(k));
+}
+
+KnotVector KnotVector::bezier(int order, double a, double b) { return uniform(order, 1, a, b); }
+
+KnotVector KnotVector::from_breakpoints(int order, std::span<const Breakpoint> breaks) {
+  std::vector<double> k;
+  for (std::size_t i = 0; i < breaks.size(); ++i) {
+    const int m = (i == 0 || i + 1 == breaks.size()) ? order : breaks[i].multiplicity;
+    for (int r = 0; r < m; ++r) k.push_back(breaks[i].value);
+  }
+  return KnotVector(order, std::move(k));
+}
+
+bool KnotVector::clamped() const noexcept {
+  const auto m = knots_.size();
+  const auto o = static_cast<std::size_t>(order_);
+  return knots_[0] == knots_[o - 1] && knots_[m - 1] == knots_[m - o];
+}
+
+std::vector<Breakpoint> KnotVector::breakpoints() const {
+  std::vector<Breakpoint> out;
+  const double a = front(), b = back();
+  for (std::size_t i = 0; i < knots_.size();) {
+    std::size_t j = i;
+    while (j < knots_.size() && knots_[j] == knots_[i]) ++j;
+    if (knots_[i] >= a && knots_[i] <= b) out.push_back({knots_[i], static_cast<int>(j - i)});
+    i = j;
+  }
+  return out;
+}
+
+int KnotVector::multiplicity(double t) const noexcept {
+  const auto r = std::equal_range(knots_.begin(), knots_.end(), t);
+  return static_cast<int>(r.second - r.first);
+}
+
+int KnotVector::find_span(double t) const noexcept {
+  const int n = size();
+  if (!(t > front())) t = front();  // also maps NaN to the front
+  if (t >= back()) {
+    // The last non-empty span ending at back().
+    int mu = n - 1;
+    while (mu > order_ - 1 && knots_[static_cast<std::size_t>(mu)] == back()) --mu;
+    return mu;
+  }
+  // upper_bound gives the first knot > t; the span starts one before it.
+  const auto it = std::upper_bound(knots_.begin() + order_ - 1, knots_.begin() + n + 1, t);
+  return static_cast<int>(it - knots_.begin()) - 1;
+}
+
+int KnotVector::find_span(double t, int hint) const noexcept {
+  if (hint >= order_ - 1 && hint < size()) {
+    const double lo = knots_[static_cast<std::size_t>(hint)];
+    const double hi = knots_[static_cast<std::size_t>(hint) + 1];
+    if (t >= lo && t < hi) return hint;
+    if (t == hi && hint == size() - 1) return hint;  // right end of the domain
+  }
+  return find_span(t);
+}
+
+void KnotVector::basis(int span, double t, double* out) const noexcept {
+  // Cox-de Boor, NURBS Book A2.2, written with the left/right differences.
+  const int p = order_ - 1;
+  double left[16], right[16];
+  double* L = left;
+  double* R = right;
+  std::vector<double> heap;
+  if (p >= 15) {
+    heap.resize(2 * static_cast<std::size_t>(p + 1));
+    L = heap.data();
+    R = heap.data() + p + 1;
+  }
+  out[0] = 1.0;
+  for (int j = 1; j <= p; ++j) {
+    L[j] = t - knots_[static_cast<std::size_t>(span + 1 - j)];
+    R[j] = knots_[static_cast<std::size_t>(span + j)] - t;
+    double saved = 0.0;
+    for (int r = 0; r < j; ++r) {
+      const double tmp = out[r] / (R[r + 1] + L[j - r]);
+      out[r] = saved + R[r + 1] * tmp;
+      saved = L[j - r] * tmp;
+    }
+    out[j] = saved;
+  }
+}
+
+void KnotVector::basis_derivatives(int span, double t, int nder, double* out) const noexcept {
+  // NURBS Book A2.3: the triangle of basis values of all degrees, then derivatives from the
+  // differences of the lower-degree functions.
+  const int p = order_ - 1;
+  const int o = order_;
+  const int requested = nder;
+  nder = std::min(nder, p);
+  // Stack storage for the usual orders; the heap only for orders above 16.
+  constexpr int stack_order = 16;
+  double ndu_stack[stack_order * stack_order], left_stack[stack_order], right_stack[stack_order];
+  std::vector<double> heap;
+  double* ndu = ndu_stack;
+  double* left = left_stack;
+  double* right = right_stack;
+  if (o > stack_order) {
+    heap.resize(static_cast<std::size_t>(o * o + 2 * o));
+    ndu = heap.data();
+    left = ndu + o * o;
+    right = left + o;
+  }
+  auto NDU = [&](int i, int j) -> double& { return ndu[i * o + j]; };
+  NDU(0, 0) = 1.0;
+  for (int j = 1; j <= p; ++j) {
+    left[j] = t - knots_[static_cast<std::size_t>(span + 1 - j)];
+    right[j] = knots_[static_cast<std::size_t>(span + j)] - t;
+    double saved = 0.0;
+    for (int r = 0; r < j; ++r) {
+      NDU(j, r) = right[r + 1] + left[j - r];  // lower triangle: knot differences
+      const double tmp = NDU(r, j - 1) / NDU(j, r);
+      NDU(r, j) = saved + right[r + 1] * tmp;
+      saved = left[j - r] * tmp;
+    }
+    NDU(j, j) = saved;
+  }
+  for (int j = 0; j <= p; ++j) out[j] = NDU(j, p);
+  double a[2][max_derivative_order + 1];
+  for (int r = 0; r <= p; ++r) {
+    int s1 = 0, s2 = 1;
+    for (auto& row : a) std::fill(std::begin(row), std::end(row), 0.0);
+    a[0][0] = 1.0;
+    for (int k = 1; k <= nder; ++k) {
+      double d = 0.0;
+      const int rk = r - k, pk = p - k;
+      if (r >= k) {
+        a[s2][0] = a[s1][0] / NDU(pk + 1, rk);
+        d = a[s2][0] * NDU(rk, pk);
+      }
+      const int j1 = (rk >= -1) ? 1 : -rk;
+      const int j2 = (r - 1 <= pk) ? k - 1 : p - r;
+      for (int j = j1; j <= j2; ++j) {
+        a[s2][j] = (a[s1][j] - a[s1][j - 1]) / NDU(pk + 1, rk + j);
+        d += a[s2][j] * NDU(rk + j, pk);
+      }
+      if (r <= pk) {
+        a[s2][k] = -a[s1][k - 1] / NDU(pk + 1, r);
+        d += a[s2][k] * NDU(r, pk);
+      }
+      out[k * o + r] = d;
+      std::swap(s1, s2);
+    }
+  }
+  int factor = p;
+  for (int k = 1; k <= nder; ++k) {
+    for (int j = 0; j <= p; ++j) out[k * o + j] *= factor;
+    factor *= (p - k);
+  }
+  // Derivatives above the degree vanish.
+  for (int k = nder + 1; k <= requested; ++k)
+    for (int j = 0; j <= p; ++j) out[k * o + j] = 0.0;
+}
+
+std::vector<double> KnotVector::greville() const {
+  std::vector<double> g(static_cast<std::size_t>(size()));
+  const int p = degree();
+  for (int i = 0; i < size(); ++i) {
+    if (p == 0) {
+      g[static_cast<std::size_t>(i)] = 0.5 * (knots_[static_cast<std::size_t>(i)] + knots_[static_cast<std::size_t>(i) + 1]);
+      continue;
+    }
+    double s = 0.0;
+    for (int j = 1; j <= p; ++j) s += knots_[static_cast<std::size_t>(i + j)];
+    g[static_cast<std::size_t>(i)] = s / p;
+  }
+  return g;
+}
+
+}  // namespace trivox::spline

@@ -1,0 +1,349 @@
+#include "trivox/spline/refine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "tensor_ops.hpp"
+#include "trivox/error.hpp"
+
+namespace trivox::spline {
+
+namespace {
+
+using detail::Net;
+
+/// A one-dimensional change of representation: the new knot vector and the matrix taking old
+/// control points to new ones.
+struct Map1D {
+  KnotVector to;
+  Eigen::MatrixXd T;
+};
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+/// Boehm's knot insertion (NURBS Book A5.1) of one knot into (knots, C), C holding one control
+/// point per row. Valid for t_mu <= t <= t_{mu+1}.
+void boehm_insert(std::vector<double>& knots, int order, Eigen::MatrixXd& C, double t) {
+  const int p = order - 1;
+  const KnotVector kv(order, knots);
+  int mu = kv.find_span(t);
+  const int n = static_cast<int>(C.rows());
+  Eigen::MatrixXd Q(n + 1, C.cols());
+  for (int i = 0; i <= mu - p; ++i) Q.row(i) = C.row(i);
+  for (int i = std::max(mu - p + 1, 0); i <= mu; ++i) {
+    const double ti = knots[static_cast<std::size_t>(i)];
+    const double a = (t - ti) / (knots[static_cast<std::size_t>(i + p)] - ti);
+    Q.row(i) = a * C.row(i) + (1.0 - a) * C.row(i - 1);
+  }
+  for (int i = mu + 1; i <= n; ++i) Q.row(i) = C.row(i - 1);
+  knots.insert(knots.begin() + mu + 1, t);
+  C = std::move(Q);
+}
+
+Map1D identity_map(const KnotVector& kv) {
+  return {kv, Eigen::MatrixXd::Identity(kv.size(), kv.size())};
+}
+
+/// Inserts `add` (sorted or not) into the map's target, composing the matrix.
+Map1D insert_into(Map1D m, std::vector<double> add) {
+  std::sort(add.begin(), add.end());
+  std::vector<double> knots = m.to.knots();
+  const int order = m.to.order();
+  for (double t : add) {
+    if (!(t >= m.to.front() && t <= m.to.back()))
+      throw Error("knot " + num(t) + " outside the domain [" + num(m.to.front()) + ", " + num(m.to.back()) +
+                  "]; expected a value inside it");
+    const auto mult = std::count(knots.begin(), knots.end(), t);
+    if (mult >= order)
+      throw Error("knot " + num(t) + " already has multiplicity " + std::to_string(mult) +
+                  "; expected at most the order (" + std::to_string(order) + ")");
+    boehm_insert(knots, order, m.T, t);
+  }
+  m.to = KnotVector(order, std::move(knots));
+  return m;
+}
+
+/// Keeps the basis functions first..first+count-1 and knots first..first+count+order-1.
+Map1D select(Map1D m, int first, int count) {
+  const int order = m.to.order();
+  std::vector<double> knots(m.to.knots().begin() + first, m.to.knots().begin() + first + count + order);
+  m.T = m.T.middleRows(first, count).eval();
+  m.to = KnotVector(order, std::move(knots));
+  return m;
+}
+
+/// Restriction to [a, b]: both ends raised to full multiplicity, the functions outside dropped.
+Map1D restrict_map(const KnotVector& kv, double a, double b) {
+  if (!(a >= kv.front() && b <= kv.back() && a < b))
+    throw Error("sub-domain [" + num(a) + ", " + num(b) + "]; expected front <= a < b <= back with domain [" +
+                num(kv.front()) + ", " + num(kv.back()) + "]");
+  const int o = kv.order();
+  std::vector<double> add;
+  for (int r = kv.multiplicity(a); r < o; ++r) add.push_back(a);
+  for (int r = kv.multiplicity(b); r < o; ++r) add.push_back(b);
+  Map1D m = insert_into(identity_map(kv), std::move(add));
+  const auto& t = m.to.knots();
+  const int first = static_cast<int>(std::lower_bound(t.begin(), t.end(), a) - t.begin());
+  const int last = static_cast<int>(std::upper_bound(t.begin(), t.end(), b) - t.begin());  // one past the last b
+  return select(std::move(m), first, last - first - o);
+}
+
+Map1D clamp_map(const KnotVector& kv) {
+  if (kv.clamped()) return identity_map(kv);
+  return restrict_map(kv, kv.front(), kv.back());
+}
+
+Map1D elevate_map(const KnotVector& kv, int by) {
+  if (by < 0) throw Error("degree elevation by " + std::to_string(by) + "; expected a non-negative amount");
+  const Map1D c = clamp_map(kv);
+  if (by == 0) return c;
+  auto br = c.to.breakpoints();
+  for (auto& b : br) b.multiplicity += by;
+  const KnotVector to = KnotVector::from_breakpoints(kv.order() + by, br);
+  return {to, detail::transfer_matrix(c.to, to) * c.T};
+}
+
+template <int P>
+void check_dir(const TensorSpline<P>& s, int dir) {
+  (void)s;
+  if (dir < 0 || dir >= P)
+    throw Error("direction " + std::to_string(dir) + "; expected 0.." + std::to_string(P - 1));
+}
+
+template <int P>
+TensorSpline<P> apply_map(const TensorSpline<P>& s, int dir, const Map1D& m) {
+  auto net = detail::apply_along(detail::to_net(s), dir, m.T);
+  auto knots = s.knot_vectors();
+  knots[static_cast<std::size_t>(dir)] = m.to;
+  return detail::from_net<P>(std::move(knots), s.dim(), s.rational(), std::move(net));
+}
+
+}  // namespace
+
+template <int P>
+TensorSpline<P> insert_knot(const TensorSpline<P>& s, int dir, double t, int times) {
+  check_dir(s, dir);
+  if (times < 0) throw Error("insert a knot " + std::to_string(times) + " times; expected a non-negative count");
+  return apply_map(s, dir, insert_into(identity_map(s.knots(dir)), std::vector<double>(static_cast<std::size_t>(times), t)));
+}
+
+template <int P>
+TensorSpline<P> refine(const TensorSpline<P>& s, int dir, std::span<const double> knots) {
+  check_dir(s, dir);
+  return apply_map(s, dir, insert_into(identity_map(s.knots(dir)), std::vector<double>(knots.begin(), knots.end())));
+}
+
+template <int P>
+TensorSpline<P> refine_uniform(const TensorSpline<P>& s, int dir, int per_span) {
+  check_dir(s, dir);
+  std::vector<double> add;
+  const auto br = s.knots(dir).breakpoints();
+  for (std::size_t i = 0; i + 1 < br.size(); ++i)
+    for (int k = 1; k <= per_span; ++k)
+      add.push_back(br[i].value + (br[i + 1].value - br[i].value) * k / (per_span + 1));
+  return refine(s, dir, add);
+}
+
+template <int P>
+TensorSpline<P> elevate(const TensorSpline<P>& s, int dir, int by) {
+  check_dir(s, dir);
+  return apply_map(s, dir, elevate_map(s.knots(dir), by));
+}
+
+template <int P>
+TensorSpline<P> clamp(const TensorSpline<P>& s, int dir) {
+  check_dir(s, dir);
+  if (s.knots(dir).clamped()) return s;
+  return apply_map(s, dir, clamp_map(s.knots(dir)));
+}
+
+template <int P>
+TensorSpline<P> clamp(const TensorSpline<P>& s) {
+  TensorSpline<P> out = s;
+  for (int d = 0; d < P; ++d) out = clamp(out, d);
+  return out;
+}
+
+template <int P>
+TensorSpline<P> to_bezier_form(const TensorSpline<P>& s, int dir) {
+  check_dir(s, dir);
+  const KnotVector& kv = s.knots(dir);
+  const Map1D c = clamp_map(kv);
+  std::vector<double> add;
+  for (const auto& b : c.to.breakpoints())
+    for (int r = b.multiplicity; r < kv.order(); ++r) add.push_back(b.value);
+  return apply_map(s, dir, insert_into(c, std::move(add)));
+}
+
+template <int P>
+std::vector<TensorSpline<P>> bezier_pieces(const TensorSpline<P>& s) {
+  TensorSpline<P> b = s;
+  for (int d = 0; d < P; ++d) b = to_bezier_form(b, d);
+  // In Bezier form the pieces are disjoint blocks of the control net.
+  std::array<std::vector<double>, P> breaks;
+  std::array<int, P> spans{};
+  for (int d = 0; d < P; ++d) {
+    for (const auto& br : b.knots(d).breakpoints()) breaks[static_cast<std::size_t>(d)].push_back(br.value);
+    spans[static_cast<std::size_t>(d)] = static_cast<int>(breaks[static_cast<std::size_t>(d)].size()) - 1;
+  }
+  int total = 1;
+  for (int d = 0; d < P; ++d) total *= spans[static_cast<std::size_t>(d)];
+  std::vector<TensorSpline<P>> out;
+  out.reserve(static_cast<std::size_t>(total));
+  const auto orders = b.orders();
+  for (int e = 0; e < total; ++e) {
+    std::array<int, P> el{};
+    int rest = e;
+    for (int d = 0; d < P; ++d) {
+      el[static_cast<std::size_t>(d)] = rest % spans[static_cast<std::size_t>(d)];
+      rest /= spans[static_cast<std::size_t>(d)];
+    }
+    std::array<KnotVector, P> knots;
+    int n = 1;
+    for (int d = 0; d < P; ++d) {
+      const auto dd = static_cast<std::size_t>(d);
+      knots[dd] = KnotVector::bezier(orders[dd], breaks[dd][static_cast<std::size_t>(el[dd])],
+                                     breaks[dd][static_cast<std::size_t>(el[dd]) + 1]);
+      n *= orders[dd];
+    }
+    std::vector<double> pts(static_cast<std::size_t>(n * s.dim()));
+    std::vector<double> w(b.rational() ? static_cast<std::size_t>(n) : 0);
+    for (int r = 0; r < n; ++r) {
+      std::array<int, P> src{};
+      int q = r;
+      for (int d = 0; d < P; ++d) {
+        const auto dd = static_cast<std::size_t>(d);
+        src[dd] = el[dd] * orders[dd] + q % orders[dd];  // Bezier form: `order` points per span
+        q /= orders[dd];
+      }
+      const int sr = b.row(src);
+      std::copy_n(b.point(sr).data(), s.dim(), pts.data() + static_cast<std::ptrdiff_t>(r) * s.dim());
+      if (b.rational()) w[static_cast<std::size_t>(r)] = b.weights()[static_cast<std::size_t>(sr)];
+    }
+    out.emplace_back(std::move(knots), s.dim(), std::move(pts), std::move(w));
+  }
+  return out;
+}
+
+template <int P>
+std::pair<TensorSpline<P>, TensorSpline<P>> split(const TensorSpline<P>& s, int dir, double t) {
+  check_dir(s, dir);
+  const KnotVector& kv = s.knots(dir);
+  if (!(t > kv.front() && t < kv.back()))
+    throw Error("split at " + num(t) + "; expected a parameter strictly inside (" + num(kv.front()) + ", " +
+                num(kv.back()) + ")");
+  return {restrict_to(s, dir, kv.front(), t), restrict_to(s, dir, t, kv.back())};
+}
+
+template <int P>
+TensorSpline<P> restrict_to(const TensorSpline<P>& s, int dir, double a, double b) {
+  check_dir(s, dir);
+  return apply_map(s, dir, restrict_map(s.knots(dir), a, b));
+}
+
+template <int P>
+TensorSpline<P> reparametrize(const TensorSpline<P>& s, int dir, double a, double b) {
+  check_dir(s, dir);
+  if (!(a < b) || !std::isfinite(a) || !std::isfinite(b))
+    throw Error("reparametrisation to [" + num(a) + ", " + num(b) + "]; expected finite a < b");
+  const KnotVector& kv = s.knots(dir);
+  const double f = kv.front(), g = kv.back();
+  std::vector<double> k = kv.knots();
+  for (double& t : k) t = (t == f) ? a : (t == g) ? b : a + (t - f) * (b - a) / (g - f);
+  auto knots = s.knot_vectors();
+  knots[static_cast<std::size_t>(dir)] = KnotVector(kv.order(), std::move(k));
+  return TensorSpline<P>(std::move(knots), s.dim(), std::vector<double>(s.points().begin(), s.points().end()), s.weights());
+}
+
+template <int P>
+TensorSpline<P> reverse(const TensorSpline<P>& s, int dir) {
+  check_dir(s, dir);
+  const KnotVector& kv = s.knots(dir);
+  const double f = kv.front(), g = kv.back();
+  std::vector<double> k(kv.knots().rbegin(), kv.knots().rend());
+  for (double& t : k) t = f + g - t;
+  auto knots = s.knot_vectors();
+  knots[static_cast<std::size_t>(dir)] = KnotVector(kv.order(), std::move(k));
+  // A permutation of the control points: exact, also for rational splines.
+  TensorSpline<P> out(std::move(knots), s.dim(), std::vector<double>(s.points().begin(), s.points().end()), s.weights());
+  const int n = kv.size();
+  for (int r = 0; r < s.size(); ++r) {
+    auto i = s.multi_index(r);
+    i[static_cast<std::size_t>(dir)] = n - 1 - i[static_cast<std::size_t>(dir)];
+    const int q = out.row(i);
+    std::copy_n(s.point(r).data(), s.dim(), out.point(q).data());
+    if (s.rational()) out.weights()[static_cast<std::size_t>(q)] = s.weights()[static_cast<std::size_t>(r)];
+  }
+  return out;
+}
+
+template <int P>
+TensorSpline<P> swap_directions(const TensorSpline<P>& s, int d1, int d2) {
+  check_dir(s, d1);
+  check_dir(s, d2);
+  if (d1 == d2) return s;
+  auto knots = s.knot_vectors();
+  std::swap(knots[static_cast<std::size_t>(d1)], knots[static_cast<std::size_t>(d2)]);
+  TensorSpline<P> out(knots, s.dim(), std::vector<double>(s.points().begin(), s.points().end()), s.weights());
+  for (int r = 0; r < s.size(); ++r) {
+    auto i = s.multi_index(r);
+    std::swap(i[static_cast<std::size_t>(d1)], i[static_cast<std::size_t>(d2)]);
+    const int q = out.row(i);
+    std::copy_n(s.point(r).data(), s.dim(), out.point(q).data());
+    if (s.rational()) out.weights()[static_cast<std::size_t>(q)] = s.weights()[static_cast<std::size_t>(r)];
+  }
+  return out;
+}
+
+template <int P>
+TensorSpline<P> to_space(const TensorSpline<P>& s, int dir, const KnotVector& target) {
+  check_dir(s, dir);
+  if (s.knots(dir) == target) return s;
+  const Map1D c = clamp_map(s.knots(dir));
+  return apply_map(s, dir, Map1D{target, detail::transfer_matrix(c.to, target) * c.T});
+}
+
+template <int P>
+std::pair<TensorSpline<P>, TensorSpline<P>> make_compatible(const TensorSpline<P>& a, const TensorSpline<P>& b) {
+  TensorSpline<P> x = a, y = b;
+  for (int d = 0; d < P; ++d) {
+    const KnotVector& ka = a.knots(d);
+    const KnotVector& kb = b.knots(d);
+    if (ka == kb) continue;
+    if (ka.front() != kb.front() || ka.back() != kb.back())
+      throw Error("direction " + std::to_string(d) + " has domains [" + num(ka.front()) + ", " + num(ka.back()) +
+                  "] and [" + num(kb.front()) + ", " + num(kb.back()) + "]; expected equal domains (reparametrise first)");
+    const KnotVector common = detail::merged_space(clamp_map(ka).to, clamp_map(kb).to, std::max(ka.order(), kb.order()));
+    x = to_space(x, d, common);
+    y = to_space(y, d, common);
+  }
+  return {std::move(x), std::move(y)};
+}
+
+#define TRIVOX_INSTANTIATE(P)                                                                             \
+  template TensorSpline<P> insert_knot(const TensorSpline<P>&, int, double, int);                         \
+  template TensorSpline<P> refine(const TensorSpline<P>&, int, std::span<const double>);                  \
+  template TensorSpline<P> refine_uniform(const TensorSpline<P>&, int, int);                              \
+  template TensorSpline<P> elevate(const TensorSpline<P>&, int, int);                                     \
+  template TensorSpline<P> clamp(const TensorSpline<P>&, int);                                            \
+  template TensorSpline<P> clamp(const TensorSpline<P>&);                                                 \
+  template TensorSpline<P> to_bezier_form(const TensorSpline<P>&, int);                                   \
+  template std::vector<TensorSpline<P>> bezier_pieces(const TensorSpline<P>&);                            \
+  template std::pair<TensorSpline<P>, TensorSpline<P>> split(const TensorSpline<P>&, int, double);        \
+  template TensorSpline<P> restrict_to(const TensorSpline<P>&, int, double, double);                      \
+  template TensorSpline<P> reparametrize(const TensorSpline<P>&, int, double, double);                    \
+  template TensorSpline<P> reverse(const TensorSpline<P>&, int);                                          \
+  template TensorSpline<P> swap_directions(const TensorSpline<P>&, int, int);                             \
+  template TensorSpline<P> to_space(const TensorSpline<P>&, int, const KnotVector&);                      \
+  template std::pair<TensorSpline<P>, TensorSpline<P>> make_compatible(const TensorSpline<P>&, const TensorSpline<P>&);
+TRIVOX_INSTANTIATE(1)
+TRIVOX_INSTANTIATE(2)
+TRIVOX_INSTANTIATE(3)
+#undef TRIVOX_INSTANTIATE
+
+}  // namespace trivox::spline

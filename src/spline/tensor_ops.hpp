@@ -1,0 +1,62 @@
+/// @file src/spline/tensor_ops.hpp
+/// @brief Private helpers of the spline module: one-dimensional linear maps on control polygons,
+/// applied to tensor-product control nets one direction at a time (the G+Smo way: write the
+/// operation once in 1-D).
+#pragma once
+#include <Eigen/Dense>
+#include <array>
+#include <vector>
+
+#include "trivox/spline/tensor_spline.hpp"
+
+namespace trivox::spline::detail {
+
+/// Control data as a dense tensor: `extents` entries per direction (first fastest), `H` values
+/// per entry.
+template <int P>
+struct Net {
+  std::array<int, P> extents{};
+  int H = 0;
+  std::vector<double> values;
+};
+
+/// The net of `s`: its points, or (w P, w) per point when rational (homogeneous coordinates, in
+/// which every linear operation on a rational spline is the polynomial operation).
+template <int P>
+Net<P> to_net(const TensorSpline<P>& s);
+
+/// The spline with the given knots whose net (homogeneous when `rational`) is `net`.
+template <int P>
+TensorSpline<P> from_net(std::array<KnotVector, P> knots, int dim, bool rational, Net<P> net);
+
+/// Replaces the extent n of direction d by T.rows(): every line of the net along d, as an n x H
+/// matrix L, becomes T * L. T is m x n.
+template <int P>
+Net<P> apply_along(const Net<P>& net, int d, const Eigen::MatrixXd& T);
+
+/// The m x n matrix taking the coefficients of a spline in the space of `from` to its coefficients
+/// in the space of `to` (which must contain it: `to` is a refinement and/or elevation of `from` on
+/// the same domain). Knot insertion uses Boehm's algorithm (exact); other cases use collocation at
+/// `to.order()` points per non-empty span, solved by least squares (exact up to rounding, since
+/// the system is consistent).
+Eigen::MatrixXd transfer_matrix(const KnotVector& from, const KnotVector& to);
+
+/// Row of basis values of `kv` at t: 1 x n (for iso-curves).
+Eigen::MatrixXd basis_row(const KnotVector& kv, double t);
+
+/// The knot vector `kv` with the knots `add` inserted (sorted merge).
+KnotVector with_knots(const KnotVector& kv, std::vector<double> add);
+
+/// Collocation matrix of `kv` at sample points: samples x n.
+Eigen::MatrixXd collocation(const KnotVector& kv, const std::vector<double>& samples);
+
+/// `k` sample points inside every non-empty span of `kv` (Chebyshev nodes of the span, never on a
+/// knot, so discontinuities do not matter).
+std::vector<double> span_samples(const KnotVector& kv, int k);
+
+/// The clamped knot vector of order `order` on the common domain of the clamped vectors a and b
+/// whose breakpoints are theirs, each with the continuity (degree - multiplicity) of the less
+/// smooth of the two there: the space of sums (order = max) or of products (order = o_a + o_b - 1).
+KnotVector merged_space(const KnotVector& a, const KnotVector& b, int order);
+
+}  // namespace trivox::spline::detail

@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Installs the dependencies, builds trivox (optimised, assertions on) and runs every test.
+# Usage: tools/test.sh            (build folder: build/; BUILD_DIR overrides)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tools/setup.sh
+build=${BUILD_DIR:-build}
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTRIVOX_ASSERTIONS=ON >/dev/null
+cmake --build "$build" -j "$jobs"
+ctest --test-dir "$build" --output-on-failure -j "$jobs"
