@@ -1,0 +1,41 @@
+#include "common.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "trivox/error.hpp"
+
+namespace trivox::cli {
+
+std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option) {
+  std::vector<double> out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t comma = text.find(',', pos);
+    const std::string item = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v))
+      throw Error(option + " " + text + ": \"" + item + "\" is not a finite number; expected " +
+                  std::to_string(count) + " comma-separated numbers");
+    out.push_back(v);
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  if (out.size() != count)
+    throw Error(option + " " + text + ": " + std::to_string(out.size()) + " numbers; expected " + std::to_string(count) +
+                " comma-separated numbers");
+  return out;
+}
+
+void print_json(const nlohmann::ordered_json& value) { std::cout << value.dump(2) << '\n'; }
+
+std::string fmt(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+}  // namespace trivox::cli

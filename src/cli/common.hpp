@@ -1,0 +1,32 @@
+/// @file src/cli/common.hpp
+/// @brief What every subcommand of the `trivox` executable shares: registration, the output
+/// mode, and parsing of option values with messages that say what was expected.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace trivox::cli {
+
+/// Options common to all subcommands.
+struct Common {
+  bool json = false;  ///< print one JSON object on stdout instead of the human summary
+};
+
+/// Each subcommand file defines one of these; main.cpp calls them in order.
+void add_info(CLI::App& app, Common& common);
+void add_eval(CLI::App& app, Common& common);
+
+/// Parses "a,b,c" into exactly `count` finite numbers.
+/// @param option  the option's name, for the message ("--uvw")
+/// @throws trivox::Error (bad_input) naming the option, the offending text and what was expected
+std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option);
+
+/// Prints a JSON value on stdout (one line per value, 2-space indented).
+void print_json(const nlohmann::ordered_json& value);
+
+/// "%.10g"-style formatting for human output.
+std::string fmt(double v, int digits = 10);
+
+}  // namespace trivox::cli

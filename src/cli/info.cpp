@@ -1,0 +1,120 @@
+// `trivox info MODEL`: what a model holds: cells with orders, control-point counts, bounding box
+// and volume (Gauss quadrature of the Jacobian determinant, exact for polynomial cells),
+// free surfaces, properties and topology counts.
+#include <tbb/parallel_for.h>
+
+#include <cstdio>
+#include <limits>
+
+#include "common.hpp"
+#include "trivox/geom/quadrature.hpp"
+#include "trivox/io/model_file.hpp"
+#include "trivox/spline/extract.hpp"
+
+namespace trivox::cli {
+
+namespace {
+
+struct Options {
+  std::string model;
+};
+
+template <int P>
+nlohmann::ordered_json spline_summary(const std::string& name, const spline::TensorSpline<P>& s) {
+  const auto box = spline::bounding_box(s, 3);
+  return {{"name", name},
+          {"orders", s.orders()},
+          {"counts", s.counts()},
+          {"rational", s.rational()},
+          {"bbox", {box[0], box[1]}}};
+}
+
+nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& file) {
+  nlohmann::ordered_json cells = nlohmann::ordered_json::array();
+  std::vector<double> volumes(m.cells.size());
+  tbb::parallel_for(std::size_t{0}, m.cells.size(), [&](std::size_t i) { volumes[i] = geom::signed_volume(m.cells[i].volume); });
+  double total = 0;
+  std::vector<double> lo(3, std::numeric_limits<double>::infinity()), hi(3, -std::numeric_limits<double>::infinity());
+  auto grow = [&](const nlohmann::ordered_json& bbox) {
+    for (std::size_t h = 0; h < 3; ++h) {
+      lo[h] = std::min(lo[h], bbox[0][h].get<double>());
+      hi[h] = std::max(hi[h], bbox[1][h].get<double>());
+    }
+  };
+  for (std::size_t i = 0; i < m.cells.size(); ++i) {
+    auto c = spline_summary(m.cells[i].name, m.cells[i].volume);
+    c["volume"] = std::abs(volumes[i]);
+    c["orientation"] = volumes[i] < 0 ? "left-handed" : "right-handed";
+    total += std::abs(volumes[i]);
+    grow(c["bbox"]);
+    cells.push_back(std::move(c));
+  }
+  nlohmann::ordered_json surfaces = nlohmann::ordered_json::array();
+  for (const auto& s : m.surfaces) {
+    auto j = spline_summary(s.name, s.surface);
+    grow(j["bbox"]);
+    surfaces.push_back(std::move(j));
+  }
+  nlohmann::ordered_json out = {{"file", file},
+                        {"units", m.units},
+                        {"properties", m.properties},
+                        {"cells", cells},
+                        {"surfaces", surfaces},
+                        {"volume", total}};
+  if (!m.cells.empty() || !m.surfaces.empty()) out["bbox"] = {lo, hi};
+  else out["bbox"] = nullptr;
+  out["topology"] = {{"v_cells", m.cells.size()}};
+  return out;
+}
+
+std::string vec(const nlohmann::ordered_json& a) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + (a[i].is_number_float() ? fmt(a[i].get<double>(), 6) : a[i].dump());
+  return s + ")";
+}
+
+void print_human(const nlohmann::ordered_json& j) {
+  std::printf("%s: %zu cells, %zu surfaces, units %s\n", j["file"].get<std::string>().c_str(), j["cells"].size(),
+              j["surfaces"].size(), j["units"].get<std::string>().c_str());
+  std::string props;
+  for (const auto& p : j["properties"]) props += (props.empty() ? "" : ", ") + p.get<std::string>();
+  std::printf("properties: %s\n", props.empty() ? "(none)" : props.c_str());
+  if (!j["bbox"].is_null()) std::printf("bounding box: %s - %s\n", vec(j["bbox"][0]).c_str(), vec(j["bbox"][1]).c_str());
+  if (!j["cells"].empty()) {
+    std::printf("\n%-16s %-10s %-13s %-14s %s\n", "cell", "orders", "counts", "volume", "bounding box");
+    for (const auto& c : j["cells"])
+      std::printf("%-16s %-10s %-13s %-14s %s - %s%s\n", c["name"].get<std::string>().c_str(), vec(c["orders"]).c_str(),
+                  vec(c["counts"]).c_str(), fmt(c["volume"].get<double>(), 10).c_str(), vec(c["bbox"][0]).c_str(),
+                  vec(c["bbox"][1]).c_str(), c["rational"].get<bool>() ? "  rational" : "");
+    std::printf("total volume: %s\n", fmt(j["volume"].get<double>(), 12).c_str());
+  }
+  if (!j["surfaces"].empty()) {
+    std::printf("\n%-16s %-10s %-13s %s\n", "surface", "orders", "counts", "bounding box");
+    for (const auto& c : j["surfaces"])
+      std::printf("%-16s %-10s %-13s %s - %s%s\n", c["name"].get<std::string>().c_str(), vec(c["orders"]).c_str(),
+                  vec(c["counts"]).c_str(), vec(c["bbox"][0]).c_str(), vec(c["bbox"][1]).c_str(),
+                  c["rational"].get<bool>() ? "  rational" : "");
+  }
+  std::string topo;
+  for (const auto& [k, v] : j["topology"].items()) topo += (topo.empty() ? "" : ", ") + k + " " + v.dump();
+  std::printf("\ntopology: %s\n", topo.c_str());
+}
+
+}  // namespace
+
+void add_info(CLI::App& app, Common& common) {
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("info", "Cells, orders, control points, properties, bounding box, volume, topology");
+  sub->add_option("MODEL", opt->model, "Model file (.json, or G+Smo .xml)")->required();
+  sub->add_flag("--json", common.json, "Print one JSON object instead of the summary");
+  sub->callback([opt, &common] {
+    const auto model = io::load_model(opt->model);
+    const auto j = summarise(model, opt->model);
+    if (common.json)
+      print_json(j);
+    else
+      print_human(j);
+  });
+}
+
+}  // namespace trivox::cli
