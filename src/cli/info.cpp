@@ -10,6 +10,7 @@
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/spline/extract.hpp"
+#include "trivox/vmodel/topology.hpp"
 
 namespace trivox::cli {
 
@@ -63,7 +64,12 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
                         {"volume", total}};
   if (!m.cells.empty() || !m.surfaces.empty()) out["bbox"] = {lo, hi};
   else out["bbox"] = nullptr;
-  out["topology"] = {{"v_cells", m.cells.size()}};
+  const auto topo = vmodel::counts(vmodel::build_topology(m));
+  out["topology"] = {{"v_cells", topo.v_cells},
+                     {"v_surfaces", topo.v_surfaces},
+                     {"half_v_surfaces", topo.half_v_surfaces},
+                     {"v_curves", topo.v_curves},
+                     {"v_points", topo.v_points}};
   return out;
 }
 

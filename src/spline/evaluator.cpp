@@ -5,8 +5,64 @@
 
 namespace trivox::spline {
 
+namespace {
+
+/// One point on a cached line: out = sum_a N[a] c[a] (and the partials from dN and the other
+/// lines). O: order along the line, H: coordinates; 0 = known only at run time.
+template <int O, int H>
+void line_kernel(int order, int dim, int lines, const double* N, const double* dN, const double* const* c, double* out) {
+  const int o = O ? O : order;
+  const int D = H ? H : dim;
+  const double* c0 = c[0];
+  for (int h = 0; h < D; ++h) {
+    double acc = 0.0;
+    for (int a = 0; a < o; ++a) acc += N[a] * c0[a * D + h];
+    out[h] = acc;
+  }
+  if (!dN) return;
+  for (int h = 0; h < D; ++h) {
+    double acc = 0.0;
+    for (int a = 0; a < o; ++a) acc += dN[a] * c0[a * D + h];
+    out[D + h] = acc;
+  }
+  for (int k = 1; k < lines; ++k) {
+    const double* ck = c[k];
+    double* dk = out + (1 + k) * D;
+    for (int h = 0; h < D; ++h) {
+      double acc = 0.0;
+      for (int a = 0; a < o; ++a) acc += N[a] * ck[a * D + h];
+      dk[h] = acc;
+    }
+  }
+}
+
+using LineKernel = void (*)(int, int, int, const double*, const double*, const double* const*, double*);
+
+template <int O>
+LineKernel pick_dim(int dim) {
+  switch (dim) {
+    case 1: return line_kernel<O, 1>;
+    case 3: return line_kernel<O, 3>;
+    case 4: return line_kernel<O, 4>;
+    case 6: return line_kernel<O, 6>;
+    default: return line_kernel<O, 0>;
+  }
+}
+
+LineKernel pick_line_kernel(int order, int dim) {
+  switch (order) {
+    case 2: return pick_dim<2>(dim);
+    case 3: return pick_dim<3>(dim);
+    case 4: return pick_dim<4>(dim);
+    default: return pick_dim<0>(dim);
+  }
+}
+
+}  // namespace
+
 template <int P>
-Evaluator<P>::Evaluator(const TensorSpline<P>& s) : s_(&s), dim_(s.dim()) {}
+Evaluator<P>::Evaluator(const TensorSpline<P>& s)
+    : s_(&s), dim_(s.dim()), line_kernel_(pick_line_kernel(s.knots(0).order(), s.dim())) {}
 
 template <int P>
 bool Evaluator<P>::cacheable() const noexcept {
@@ -124,24 +180,10 @@ void Evaluator<P>::eval_on_line(double u, bool derivs, double* out) {
   Basis1 bu;
   basis_at(0, u, derivs, bu);
   const int o = s_->knots(0).order();
-  const double* dN = &bu.N[0][0] + o;
-  const int H = dim_;
-  const double* c0 = line_[0].data() + static_cast<std::size_t>(bu.first) * static_cast<std::size_t>(H);
-  for (int h = 0; h < H; ++h) out[h] = 0.0;
-  for (int a = 0; a < o; ++a)
-    for (int h = 0; h < H; ++h) out[h] += bu.N[0][a] * c0[a * H + h];
-  if (!derivs) return;
-  double* du = out + H;
-  for (int h = 0; h < H; ++h) du[h] = 0.0;
-  for (int a = 0; a < o; ++a)
-    for (int h = 0; h < H; ++h) du[h] += dN[a] * c0[a * H + h];
-  for (int k = 1; k < P; ++k) {
-    const double* ck = line_[k].data() + static_cast<std::size_t>(bu.first) * static_cast<std::size_t>(H);
-    double* dk = out + (1 + k) * H;
-    for (int h = 0; h < H; ++h) dk[h] = 0.0;
-    for (int a = 0; a < o; ++a)
-      for (int h = 0; h < H; ++h) dk[h] += bu.N[0][a] * ck[a * H + h];
-  }
+  const auto off = static_cast<std::size_t>(bu.first) * static_cast<std::size_t>(dim_);
+  const double* c[3] = {line_[0].data() + off, derivs && P > 1 ? line_[1].data() + off : nullptr,
+                        derivs && P > 2 ? line_[2].data() + off : nullptr};
+  line_kernel_(o, dim_, P, bu.N[0], derivs ? &bu.N[0][0] + o : nullptr, c, out);
 }
 
 namespace {

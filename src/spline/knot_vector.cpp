@@ -110,22 +110,17 @@ int KnotVector::find_span(double t, int hint) const noexcept {
   return find_span(t);
 }
 
-void KnotVector::basis(int span, double t, double* out) const noexcept {
-  // Cox-de Boor, NURBS Book A2.2, written with the left/right differences.
-  const int p = order_ - 1;
-  double left[16], right[16];
-  double* L = left;
-  double* R = right;
-  std::vector<double> heap;
-  if (p >= 15) {
-    heap.resize(2 * static_cast<std::size_t>(p + 1));
-    L = heap.data();
-    R = heap.data() + p + 1;
-  }
+namespace {
+
+/// Cox-de Boor up to degree p (NURBS Book A2.2, with the left/right differences) on knots `k`
+/// around span mu; `P` = p when known at compile time (the loops unroll), else -1.
+template <int Pc>
+inline void cox_de_boor(const double* k, int mu, double t, int p, double* out, double* L, double* R) {
+  if constexpr (Pc >= 0) p = Pc;
   out[0] = 1.0;
   for (int j = 1; j <= p; ++j) {
-    L[j] = t - knots_[static_cast<std::size_t>(span + 1 - j)];
-    R[j] = knots_[static_cast<std::size_t>(span + j)] - t;
+    L[j] = t - k[mu + 1 - j];
+    R[j] = k[mu + j] - t;
     double saved = 0.0;
     for (int r = 0; r < j; ++r) {
       const double tmp = out[r] / (R[r + 1] + L[j - r]);
@@ -136,11 +131,72 @@ void KnotVector::basis(int span, double t, double* out) const noexcept {
   }
 }
 
+/// Values and first derivatives of the degree-p functions: the degree p-1 values M, then
+/// N'_{i,p} = p (M_{i-1} / (t_{i+p} - t_i) - M_i / (t_{i+p+1} - t_{i+1})) (NURBS Book eq. 2.9)
+/// and the last Cox-de Boor step for the values.
+template <int Pc>
+inline void values_and_slopes(const double* k, int mu, double t, int p, double* out, double* L, double* R) {
+  if constexpr (Pc >= 0) p = Pc;
+  double* val = out;
+  double* der = out + p + 1;
+  cox_de_boor<(Pc > 0 ? Pc - 1 : -1)>(k, mu, t, p - 1, val, L, R);
+  // der_j from M_{j-1}, M_j (val holds M_0..M_{p-1}).
+  double prev = 0.0;  // M_{j-1} / (t_{mu+j} - t_{mu-p+j})
+  for (int j = 0; j < p; ++j) {
+    const double q = val[j] / (k[mu + j + 1] - k[mu - p + j + 1]);
+    der[j] = p * (prev - q);
+    prev = q;
+  }
+  der[p] = p * prev;
+  // Raise the values to degree p.
+  L[p] = t - k[mu + 1 - p];
+  R[p] = k[mu + p] - t;
+  double saved = 0.0;
+  for (int r = 0; r < p; ++r) {
+    const double tmp = val[r] / (R[r + 1] + L[p - r]);
+    val[r] = saved + R[r + 1] * tmp;
+    saved = L[p - r] * tmp;
+  }
+  val[p] = saved;
+}
+
+}  // namespace
+
+void KnotVector::basis(int span, double t, double* out) const noexcept {
+  const int p = order_ - 1;
+  double L[16], R[16];
+  const double* k = knots_.data();
+  switch (p) {
+    case 0: out[0] = 1.0; return;
+    case 1: return cox_de_boor<1>(k, span, t, p, out, L, R);
+    case 2: return cox_de_boor<2>(k, span, t, p, out, L, R);
+    case 3: return cox_de_boor<3>(k, span, t, p, out, L, R);
+    case 4: return cox_de_boor<4>(k, span, t, p, out, L, R);
+    case 5: return cox_de_boor<5>(k, span, t, p, out, L, R);
+    default: break;
+  }
+  if (p < 16) return cox_de_boor<-1>(k, span, t, p, out, L, R);
+  std::vector<double> heap(2 * static_cast<std::size_t>(p + 1));
+  cox_de_boor<-1>(k, span, t, p, out, heap.data(), heap.data() + p + 1);
+}
+
 void KnotVector::basis_derivatives(int span, double t, int nder, double* out) const noexcept {
   // NURBS Book A2.3: the triangle of basis values of all degrees, then derivatives from the
   // differences of the lower-degree functions.
   const int p = order_ - 1;
   const int o = order_;
+  if (nder == 1 && p >= 1 && p < 16) {
+    // The common case (first partials) without the full derivative triangle.
+    double L[16], R[16];
+    const double* k = knots_.data();
+    switch (p) {
+      case 1: return values_and_slopes<1>(k, span, t, p, out, L, R);
+      case 2: return values_and_slopes<2>(k, span, t, p, out, L, R);
+      case 3: return values_and_slopes<3>(k, span, t, p, out, L, R);
+      case 4: return values_and_slopes<4>(k, span, t, p, out, L, R);
+      default: return values_and_slopes<-1>(k, span, t, p, out, L, R);
+    }
+  }
   const int requested = nder;
   nder = std::min(nder, p);
   // Stack storage for the usual orders; the heap only for orders above 16.

@@ -250,48 +250,73 @@ struct FastBasis {
   double N[2 * kMaxOrderStack];  // row 0 values, row 1 first derivatives (length `order` each)
 };
 
-template <int H>
+template <int O, int H>
 void fast_contract(const double* pts, int dim, const FastBasis (&b)[3], bool d1, double* out) {
+  // O > 0: every direction has order O (loops unroll); O == 0: orders from b.
   constexpr int cap = H ? H : 64;
   const int D = H ? H : dim;
-  double val[cap] = {}, du[cap] = {}, dv[cap] = {}, dw[cap] = {};
+  const int ou = O ? O : b[0].order, ov = O ? O : b[1].order, ow = O ? O : b[2].order;
+  double val[cap], du[cap], dv[cap], dw[cap];
+  for (int h = 0; h < D; ++h) val[h] = du[h] = dv[h] = dw[h] = 0.0;
   const double *Nu = b[0].N, *Nv = b[1].N, *Nw = b[2].N;
-  const double *Du = Nu + b[0].order, *Dv = Nv + b[1].order, *Dw = Nw + b[2].order;
-  for (int c = 0; c < b[2].order; ++c) {
-    for (int bb = 0; bb < b[1].order; ++bb) {
+  const double *Du = Nu + ou, *Dv = Nv + ov, *Dw = Nw + ow;
+  const std::ptrdiff_t su = b[0].stride * D;
+  for (int c = 0; c < ow; ++c) {
+    for (int bb = 0; bb < ov; ++bb) {
       const double* row = pts + static_cast<std::ptrdiff_t>(b[0].first * b[0].stride + (b[1].first + bb) * b[1].stride +
                                                               (b[2].first + c) * b[2].stride) * D;
-      double t0[cap] = {}, t1[cap] = {};
-      for (int a = 0; a < b[0].order; ++a) {
-        const double* q = row + static_cast<std::ptrdiff_t>(a * b[0].stride) * D;
-        const double n0 = Nu[a];
-        for (int h = 0; h < D; ++h) t0[h] += n0 * q[h];
-        if (d1) {
-          const double n1 = Du[a];
-          for (int h = 0; h < D; ++h) t1[h] += n1 * q[h];
+      const double vw = Nv[bb] * Nw[c];
+      if (!d1) {
+        for (int a = 0; a < ou; ++a) {
+          const double* q = row + a * su;
+          const double coef = Nu[a] * vw;
+          for (int h = 0; h < D; ++h) val[h] += coef * q[h];
+        }
+        continue;
+      }
+      double t0[cap], t1[cap];
+      for (int h = 0; h < D; ++h) t0[h] = t1[h] = 0.0;
+      for (int a = 0; a < ou; ++a) {
+        const double* q = row + a * su;
+        const double n0 = Nu[a], n1 = Du[a];
+        for (int h = 0; h < D; ++h) {
+          t0[h] += n0 * q[h];
+          t1[h] += n1 * q[h];
         }
       }
-      const double vw = Nv[bb] * Nw[c];
-      for (int h = 0; h < D; ++h) val[h] += vw * t0[h];
-      if (d1) {
-        const double dvw = Dv[bb] * Nw[c], vdw = Nv[bb] * Dw[c];
-        for (int h = 0; h < D; ++h) {
-          du[h] += vw * t1[h];
-          dv[h] += dvw * t0[h];
-          dw[h] += vdw * t0[h];
-        }
+      const double dvw = Dv[bb] * Nw[c], vdw = Nv[bb] * Dw[c];
+      for (int h = 0; h < D; ++h) {
+        val[h] += vw * t0[h];
+        du[h] += vw * t1[h];
+        dv[h] += dvw * t0[h];
+        dw[h] += vdw * t0[h];
       }
     }
   }
   for (int h = 0; h < D; ++h) out[h] = val[h];
   if (!d1) return;
-  // Only the partials of existing directions are written (P = b-count with stride > 0).
+  // Only the partials of existing directions are written (those with a stride).
   double* o = out + D;
   const double* parts[3] = {du, dv, dw};
   for (int d = 0; d < 3; ++d) {
     if (b[d].stride == 0) continue;
     for (int h = 0; h < D; ++h) o[h] = parts[d][h];
     o += D;
+  }
+}
+
+template <int O>
+void fast_contract_dim(const double* pts, int dim, const FastBasis (&b)[3], bool d1, double* out) {
+  switch (dim) {
+    case 1: return fast_contract<O, 1>(pts, 1, b, d1, out);
+    case 2: return fast_contract<O, 2>(pts, 2, b, d1, out);
+    case 3: return fast_contract<O, 3>(pts, 3, b, d1, out);
+    case 4: return fast_contract<O, 4>(pts, 4, b, d1, out);
+    case 5: return fast_contract<O, 5>(pts, 5, b, d1, out);
+    case 6: return fast_contract<O, 6>(pts, 6, b, d1, out);
+    case 7: return fast_contract<O, 7>(pts, 7, b, d1, out);
+    case 8: return fast_contract<O, 8>(pts, 8, b, d1, out);
+    default: return fast_contract<O, 0>(pts, dim, b, d1, out);
   }
 }
 
@@ -326,16 +351,13 @@ bool fast_eval(const TensorSpline<P>& s, const std::array<double, P>& t, int max
   }
   const double* pts = s.points().data();
   const bool d1 = max_order == 1;
-  switch (s.dim()) {
-    case 1: fast_contract<1>(pts, 1, b, d1, out); break;
-    case 2: fast_contract<2>(pts, 2, b, d1, out); break;
-    case 3: fast_contract<3>(pts, 3, b, d1, out); break;
-    case 4: fast_contract<4>(pts, 4, b, d1, out); break;
-    case 5: fast_contract<5>(pts, 5, b, d1, out); break;
-    case 6: fast_contract<6>(pts, 6, b, d1, out); break;
-    case 7: fast_contract<7>(pts, 7, b, d1, out); break;
-    case 8: fast_contract<8>(pts, 8, b, d1, out); break;
-    default: fast_contract<0>(pts, s.dim(), b, d1, out); break;
+  const int o = b[0].order;
+  const bool uniform = P == 3 && b[1].order == o && b[2].order == o;
+  switch (uniform ? o : 0) {
+    case 2: fast_contract_dim<2>(pts, s.dim(), b, d1, out); break;
+    case 3: fast_contract_dim<3>(pts, s.dim(), b, d1, out); break;
+    case 4: fast_contract_dim<4>(pts, s.dim(), b, d1, out); break;
+    default: fast_contract_dim<0>(pts, s.dim(), b, d1, out); break;
   }
   return true;
 }

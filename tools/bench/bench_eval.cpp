@@ -8,6 +8,8 @@
 // shows both paths compute the same values.
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <algorithm>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -53,9 +55,10 @@ double measure(std::size_t count, F&& f) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   const Trivariate s = make_spline();
-  const int g = 100;
+  // Optional argument: points per grid direction (default 100, i.e. 10^6 parameters).
+  const int g = argc > 1 ? std::max(2, std::atoi(argv[1])) : 100;
   const std::size_t N = static_cast<std::size_t>(g) * g * g;
   std::vector<std::array<double, 3>> coherent(N), random(N);
   for (int k = 0, r = 0; k < g; ++k)

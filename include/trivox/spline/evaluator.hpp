@@ -44,6 +44,9 @@ private:
 
   const TensorSpline<P>* s_;
   int dim_;
+  /// The curve evaluation on a cached line, specialised for the order along it and dim().
+  void (*line_kernel_)(int order, int dim, int lines, const double* N, const double* dN, const double* const* lines_at,
+                       double* out);
   int hint_[3] = {0, 0, 0};
   // Line cache: the net contracted over directions 1..P-1 at fixed parameters (n_0 x dim each:
   // value, then d/dt_1 and d/dt_2 when built with derivatives).
