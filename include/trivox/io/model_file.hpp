@@ -1,0 +1,52 @@
+/// @file trivox/io/model_file.hpp
+/// @brief Loading a model from disk in any supported format, and saving one safely.
+///
+/// `load_model` reads the whole file and picks the reader by content, not by extension: the
+/// first character other than white space (and a UTF-8 byte-order mark) is `{` for a trivox JSON
+/// model (model_json.hpp) or `<` for G+Smo XML (gismo_xml.hpp). `save_model` writes JSON to a
+/// temporary file in the target's folder, flushes it to disk and renames it over the target, so
+/// a reader never sees a partial file under the final name, even if trivox is killed mid-write.
+///
+/// Cost: one read (or write) of the file plus the parse (or format), linear in its size.
+#pragma once
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "trivox/vmodel/vmodel.hpp"
+
+namespace trivox::io {
+
+enum class ModelFormat {
+  json,       ///< trivox model file (model_json.hpp)
+  gismo_xml,  ///< G+Smo XML geometry (gismo_xml.hpp)
+};
+
+/// Which reader `text` needs, from its first significant character.
+/// @param source  the file name, for the message
+/// @throws trivox::Error (bad_input) for an empty file or one starting with anything else
+ModelFormat detect_model_format(std::string_view text, const std::string& source);
+
+/// Parses `text` with the reader its content calls for.
+vmodel::VModel read_model(std::string_view text, const std::string& source);
+
+/// Reads and parses the model file at `path`; messages name the file as `path.string()`.
+/// @throws trivox::Error (bad_input) when the file is missing, a directory or unreadable, and
+///         for every problem the readers report
+vmodel::VModel load_model(const std::filesystem::path& path);
+
+/// Writes `model` as a JSON model file at `path`, replacing any file there atomically.
+/// @throws trivox::Error (bad_input) when `path` ends in `.xml` (trivox writes JSON only), when
+///         the model cannot be written (see write_model_json) or the folder is not writable
+void save_model(const vmodel::VModel& model, const std::filesystem::path& path);
+
+/// The whole content of a file, as bytes.
+/// @throws trivox::Error (bad_input) "<path>: no such file; expected ..." and similar
+std::string read_file(const std::filesystem::path& path);
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, after
+/// fsync: the file at `path` is either the old one or the complete new one.
+/// @throws trivox::Error (bad_input) naming the path and the system's reason
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace trivox::io

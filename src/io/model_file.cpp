@@ -1,0 +1,176 @@
+#include "trivox/io/model_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <thread>
+
+#include "trivox/error.hpp"
+#include "trivox/io/gismo_xml.hpp"
+#include "trivox/io/model_json.hpp"
+
+namespace trivox::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string system_reason(int err) { return std::strerror(err); }
+
+/// An open file descriptor, closed on every path out (a failed write must not leak it).
+class Fd {
+public:
+  explicit Fd(int fd) noexcept : fd_(fd) {}
+  Fd(const Fd&) = delete;
+  Fd& operator=(const Fd&) = delete;
+  ~Fd() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  int get() const noexcept { return fd_; }
+  /// Closes now, reporting the error close() may give (NFS reports write errors here).
+  int close() noexcept {
+    const int r = ::close(fd_);
+    fd_ = -1;
+    return r;
+  }
+
+private:
+  int fd_;
+};
+
+/// A fresh name next to `path` for the temporary file. Unique per process, thread and instant;
+/// O_EXCL catches the rest.
+fs::path temporary_name(const fs::path& path, int attempt) {
+  const auto tid = std::hash<std::thread::id>{}(std::this_thread::get_id());
+  const auto now = std::chrono::steady_clock::now().time_since_epoch().count();
+  std::ostringstream s;
+  s << "." << path.filename().string() << ".tmp-" << ::getpid() << "-" << std::hex
+    << (tid ^ static_cast<std::size_t>(now)) << "-" << attempt;
+  return path.parent_path() / s.str();
+}
+
+/// Creates the temporary file (0666 minus umask, like any new file); returns its descriptor.
+int create_temporary(const fs::path& path, fs::path& tmp) {
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    tmp = temporary_name(path, attempt);
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0 || errno != EEXIST) return fd;
+  }
+  errno = EEXIST;
+  return -1;
+}
+
+bool write_all(int fd, std::string_view bytes) {
+  while (!bytes.empty()) {
+    const ssize_t n = ::write(fd, bytes.data(), bytes.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    bytes.remove_prefix(static_cast<std::size_t>(n));
+  }
+  return true;
+}
+
+[[noreturn]] void write_failed(const fs::path& path, const fs::path& tmp, int err) {
+  if (!tmp.empty()) ::unlink(tmp.c_str());
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw Error(path.string() + ": cannot write: folder " + dir.string() +
+                " does not exist; expected an existing, writable folder");
+  throw Error(path.string() + ": cannot write: " + system_reason(err) +
+              "; expected a writable path");
+}
+
+/// Makes the rename itself durable; failure here loses nothing already written, so it is ignored.
+void sync_folder(const fs::path& path) {
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+ModelFormat detect_model_format(std::string_view text, const std::string& source) {
+  std::size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;  // UTF-8 byte-order mark
+  while (i < text.size() &&
+         (text[i] == ' ' || text[i] == '\t' || text[i] == '\n' || text[i] == '\r'))
+    ++i;
+  const std::string expected =
+      "expected a trivox JSON model (starting with '{') or G+Smo XML "
+      "(starting with '<')";
+  if (i == text.size()) throw Error(source + ": the file is empty; " + expected);
+  if (text[i] == '{') return ModelFormat::json;
+  if (text[i] == '<') return ModelFormat::gismo_xml;
+  const unsigned char c = static_cast<unsigned char>(text[i]);
+  const std::string shown =
+      c >= 0x20 && c < 0x7f ? std::string("'") + text[i] + "'" : "byte " + std::to_string(c);
+  throw Error(source + ": the file starts with " + shown + "; " + expected);
+}
+
+vmodel::VModel read_model(std::string_view text, const std::string& source) {
+  switch (detect_model_format(text, source)) {
+    case ModelFormat::json: return read_model_json(text, source);
+    case ModelFormat::gismo_xml: return read_gismo_xml(text, source);
+  }
+  throw Error(source + ": unknown model format; expected JSON or G+Smo XML");
+}
+
+std::string read_file(const fs::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!fs::exists(st))
+    throw Error(name + ": no such file; expected an existing model file (.json or G+Smo .xml)");
+  if (fs::is_directory(st))
+    throw Error(name + ": is a folder; expected a model file (.json or G+Smo .xml)");
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+    throw Error(name + ": cannot open: " + system_reason(errno) + "; expected a readable file");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (in.bad() || bytes.bad())
+    throw Error(name + ": cannot read: " + system_reason(errno) + "; expected a readable file");
+  return std::move(bytes).str();
+}
+
+vmodel::VModel load_model(const fs::path& path) {
+  const std::string text = read_file(path);
+  return read_model(text, path.string());
+}
+
+void write_file_atomically(const fs::path& path, std::string_view bytes) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw Error(path.string() + ": is a folder; expected a file path to write");
+  fs::path tmp;
+  Fd fd(create_temporary(path, tmp));
+  if (fd.get() < 0) write_failed(path, {}, errno);
+  if (!write_all(fd.get(), bytes) || ::fsync(fd.get()) != 0) write_failed(path, tmp, errno);
+  if (fd.close() != 0) write_failed(path, tmp, errno);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) write_failed(path, tmp, errno);
+  sync_folder(path);
+}
+
+void save_model(const vmodel::VModel& model, const fs::path& path) {
+  if (path.extension() == ".xml")
+    throw Error(path.string() +
+                ": an .xml name; expected a .json name (trivox writes models "
+                "as JSON only)");
+  std::string text;
+  try {
+    text = write_model_json(model);
+  } catch (const Error& e) {
+    throw e.within(path.string());
+  }
+  write_file_atomically(path, text);
+}
+
+}  // namespace trivox::io

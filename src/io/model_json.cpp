@@ -1,0 +1,601 @@
+#include "trivox/io/model_json.hpp"
+
+#include <array>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "trivox/error.hpp"
+
+namespace trivox::io {
+
+namespace {
+
+using nlohmann::json;
+using spline::KnotVector;
+
+constexpr std::array<std::string_view, 5> units_list = {"um", "mm", "cm", "m", "in"};
+
+// ------------------------------------------------------------------------------------------
+// Message pieces
+
+/// The file being read: every message starts with its name and a JSON pointer.
+struct Source {
+  const std::string& name;
+
+  [[noreturn]] void fail(const std::string& ptr, const std::string& what) const {
+    throw Error(name + ": " + (ptr.empty() ? std::string("top level") : ptr) + ": " + what);
+  }
+  /// For wrapping errors thrown by lower layers (KnotVector, TensorSpline).
+  std::string at(const std::string& ptr) const { return name + ": " + ptr; }
+};
+
+std::string child(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
+std::string child(const std::string& ptr, const char* key) { return ptr + "/" + key; }
+
+/// Shortest round-trip text of a double, always with a '.' or exponent so that a reader keeps it
+/// a floating-point number (this is what keeps -0.0 negative through nlohmann's parser).
+std::string format_double(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, r.ptr);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+/// A JSON string literal, ASCII only so that a message never carries broken UTF-8.
+std::string quote(const std::string& s) {
+  return json(s).dump(-1, ' ', true, json::error_handler_t::replace);
+}
+
+std::string plural(std::int64_t n, const std::string& word) {
+  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
+}
+
+/// What a value is, for "found ...; expected ..." messages.
+std::string describe(const json& j) {
+  switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return j.get<bool>() ? "true" : "false";
+    case json::value_t::string: {
+      std::string s = quote(j.get<std::string>());
+      if (s.size() > 40) s = s.substr(0, 36) + "...\"";
+      return "the string " + s;
+    }
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "the number " + j.dump();
+    case json::value_t::array: return "an array of " + std::to_string(j.size());
+    case json::value_t::object: return "an object";
+    default: return "a binary value";
+  }
+}
+
+[[noreturn]] void fail_type(const Source& src, const std::string& ptr, const json& j,
+                            const std::string& expected) {
+  src.fail(ptr, "found " + describe(j) + "; expected " + expected);
+}
+
+// ------------------------------------------------------------------------------------------
+// Parsing with positions
+
+/// nlohmann's DOM builder, but keeping the byte position of a failure: the library reports a
+/// number overflow (1e999) without one, and the user needs a line to find it.
+class PositionedParser : public nlohmann::detail::json_sax_dom_parser<json> {
+public:
+  explicit PositionedParser(json& root) : json_sax_dom_parser(root, false) {}
+
+  template <class Exception>
+  bool parse_error(std::size_t position, const std::string& token, const Exception& ex) {
+    failed_ = true;
+    message_ = ex.what();
+    // A syntax error is placed at the last character read; an overflowing number at its start.
+    const bool overflow = message_.find("number overflow") != std::string::npos;
+    position_ = overflow && position > token.size() ? position - token.size() + 1 : position;
+    return false;
+  }
+
+  bool failed() const noexcept { return failed_; }
+  std::size_t position() const noexcept { return position_; }
+  const std::string& message() const noexcept { return message_; }
+
+private:
+  bool failed_ = false;
+  std::size_t position_ = 0;
+  std::string message_;
+};
+
+/// "line L, column C" of the character nlohmann read last before failing (position counts the
+/// characters read, so the culprit is at position - 1).
+std::string line_column(std::string_view text, std::size_t position) {
+  const std::size_t at = std::min(position > 0 ? position - 1 : 0, text.size());
+  std::size_t line = 1, line_start = 0;
+  for (std::size_t i = 0; i < at; ++i)
+    if (text[i] == '\n') ++line, line_start = i + 1;
+  return "line " + std::to_string(line) + ", column " + std::to_string(at - line_start + 1);
+}
+
+/// Keeps the end of nlohmann's "last read: '<token>'" short and ASCII: an unterminated string
+/// would otherwise put the rest of the file, with any invalid bytes, into the message.
+std::string shorten_last_read(std::string what) {
+  const std::string open = "last read: '";
+  const auto begin = what.find(open);
+  if (begin == std::string::npos) return what;
+  const auto from = begin + open.size();
+  auto to = what.rfind("'; expected");
+  if (to == std::string::npos || to < from) to = what.rfind('\'');
+  if (to == std::string::npos || to < from) return what;
+  std::string token = what.substr(from, to - from);
+  if (token.size() > 40) token = "..." + token.substr(token.size() - 37);
+  for (char& c : token)
+    if (static_cast<unsigned char>(c) >= 0x7f || static_cast<unsigned char>(c) < 0x20) c = '?';
+  return what.substr(0, from) + token + what.substr(to);
+}
+
+/// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix
+/// (we give our own position), ending with what was expected.
+std::string parse_message(std::string what) {
+  what = shorten_last_read(std::move(what));
+  if (what.starts_with("[json.exception.")) {
+    if (const auto p = what.find("] "); p != std::string::npos) what.erase(0, p + 2);
+  }
+  if (what.starts_with("parse error")) {
+    if (const auto p = what.find(": "); p != std::string::npos) what.erase(0, p + 2);
+  }
+  if (what.find("number overflow") != std::string::npos)
+    return what + "; expected a finite number (magnitude below 1.8e308)";
+  if (what.find("expected") == std::string::npos) what += "; expected well-formed JSON";
+  return what;
+}
+
+json parse(const Source& src, std::string_view text) {
+  json root;
+  PositionedParser parser(root);
+  json::sax_parse(text.begin(), text.end(), &parser, nlohmann::detail::input_format_t::json,
+                  /*strict=*/true, /*ignore_comments=*/false);
+  if (parser.failed())
+    throw Error(src.name + ": " + line_column(text, parser.position()) +
+                ": malformed JSON: " + parse_message(parser.message()));
+  return root;
+}
+
+// ------------------------------------------------------------------------------------------
+// Typed access: every value's type is checked before it is read
+
+const json* find(const json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+const json& require(const Source& src, const json& object, const std::string& ptr, const char* key,
+                    const std::string& expected) {
+  if (const json* j = find(object, key)) return *j;
+  src.fail(ptr, std::string("missing \"") + key + "\"; expected " + expected);
+}
+
+const json& expect_object(const Source& src, const json& j, const std::string& ptr,
+                          const std::string& expected) {
+  if (!j.is_object()) fail_type(src, ptr, j, expected);
+  return j;
+}
+
+const json& expect_array(const Source& src, const json& j, const std::string& ptr,
+                         const std::string& expected) {
+  if (!j.is_array()) fail_type(src, ptr, j, expected);
+  return j;
+}
+
+double read_number(const Source& src, const json& j, const std::string& ptr) {
+  if (!j.is_number()) fail_type(src, ptr, j, "a number");
+  const double v = j.get<double>();
+  // The parser rejects overflowing literals; this guards models built by other means.
+  if (!std::isfinite(v)) src.fail(ptr, "found " + format_double(v) + "; expected a finite number");
+  return v;
+}
+
+/// read_number of element i of `parent`, building the pointer text only for a message: files
+/// hold millions of numbers.
+double read_number_at(const Source& src, const json& j, const std::string& parent, std::size_t i) {
+  if (j.is_number()) {
+    const double v = j.get<double>();
+    if (std::isfinite(v)) return v;
+  }
+  return read_number(src, j, child(parent, i));
+}
+
+/// An integer in [lo, hi]; 2.0 counts as 2, since some writers emit every number as a double.
+int read_int(const Source& src, const json& j, const std::string& ptr, int lo, int hi,
+             const std::string& expected) {
+  if (!j.is_number()) fail_type(src, ptr, j, expected);
+  const double v = j.get<double>();
+  if (v != std::floor(v) || v < lo || v > hi) fail_type(src, ptr, j, expected);
+  return static_cast<int>(v);
+}
+
+std::string read_string(const Source& src, const json& j, const std::string& ptr,
+                        const std::string& expected) {
+  if (!j.is_string()) fail_type(src, ptr, j, expected);
+  return j.get<std::string>();
+}
+
+std::vector<double> read_numbers(const Source& src, const json& j, const std::string& ptr,
+                                 const std::string& expected) {
+  expect_array(src, j, ptr, expected);
+  std::vector<double> out;
+  out.reserve(j.size());
+  for (std::size_t i = 0; i < j.size(); ++i) out.push_back(read_number_at(src, j[i], ptr, i));
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------
+// Splines
+
+/// What each control point holds, for messages: dim 6, "6 (xyz + 3 properties)".
+struct PointShape {
+  int dim;
+  std::string text;
+};
+
+PointShape point_shape(std::size_t properties) {
+  const int dim = 3 + static_cast<int>(properties);
+  if (properties == 0) return {dim, "3 (xyz)"};
+  const std::string props =
+      properties == 1 ? "1 property" : std::to_string(properties) + " properties";
+  return {dim, std::to_string(dim) + " (xyz + " + props + ")"};
+}
+
+template <int P>
+std::array<int, P> read_orders(const Source& src, const json& j, const std::string& ptr) {
+  const std::string what = std::to_string(P) + " orders (degree + 1), one per direction";
+  expect_array(src, j, ptr, what);
+  if (j.size() != P)
+    src.fail(ptr, plural(static_cast<std::int64_t>(j.size()), "order") + "; expected " + what);
+  std::array<int, P> orders{};
+  for (int d = 0; d < P; ++d)
+    orders[d] = read_int(src, j[d], child(ptr, d), 1, INT_MAX,
+                         "an integer order (degree + 1) of at least 1");
+  return orders;
+}
+
+KnotVector read_knot_vector(const Source& src, const json& j, const std::string& ptr, int order) {
+  std::vector<double> knots = read_numbers(src, j, ptr, "an array of knots");
+  for (std::size_t i = 1; i < knots.size(); ++i)
+    if (knots[i] < knots[i - 1])
+      src.fail(child(ptr, i), "knot " + format_double(knots[i]) + " is less than knot " +
+                                  std::to_string(i - 1) + " (" + format_double(knots[i - 1]) +
+                                  "); expected non-decreasing knots");
+  // Checked here, in 64 bits, so that KnotVector never computes 2 * order from a huge order.
+  const auto needed = 2 * static_cast<std::int64_t>(order);
+  if (static_cast<std::int64_t>(knots.size()) < needed)
+    src.fail(ptr, plural(static_cast<std::int64_t>(knots.size()), "knot") + " for order " +
+                      std::to_string(order) + "; expected at least " + std::to_string(needed) +
+                      " (control points + order, with at least order control points)");
+  try {
+    return KnotVector(order, std::move(knots));
+  } catch (const Error& e) {
+    throw e.within(src.at(ptr));
+  }
+}
+
+/// Product of the counts, saturating: absurd counts must give a message, not an overflow.
+std::int64_t saturating_product(std::int64_t a, std::int64_t b) {
+  return (b != 0 && a > INT64_MAX / b) ? INT64_MAX : a * b;
+}
+
+std::vector<double> read_points(const Source& src, const json& j, const std::string& ptr,
+                                std::int64_t count, const std::string& count_text,
+                                const PointShape& shape) {
+  const std::string row_what = "a control point: an array of " + shape.text + " numbers";
+  expect_array(src, j, ptr, "an array of control points, each " + row_what);
+  if (static_cast<std::int64_t>(j.size()) != count)
+    src.fail(ptr, plural(static_cast<std::int64_t>(j.size()), "control point") + "; expected " +
+                      count_text);
+  std::vector<double> out;
+  out.reserve(j.size() * static_cast<std::size_t>(shape.dim));
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const json& row = j[i];
+    if (!row.is_array()) fail_type(src, child(ptr, i), row, row_what);
+    if (row.size() != static_cast<std::size_t>(shape.dim))
+      src.fail(child(ptr, i), plural(static_cast<std::int64_t>(row.size()), "coordinate") +
+                                  "; expected " + shape.text);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (row[k].is_number() && std::isfinite(row[k].get<double>()))
+        out.push_back(row[k].get<double>());
+      else
+        read_number(src, row[k], child(child(ptr, i), k));  // throws with the pointer
+    }
+  }
+  return out;
+}
+
+std::vector<double> read_weights(const Source& src, const json* j, const std::string& ptr,
+                                 std::int64_t count) {
+  if (j == nullptr || j->is_null()) return {};
+  std::vector<double> w = read_numbers(src, *j, ptr, "null or an array of positive weights");
+  if (static_cast<std::int64_t>(w.size()) != count)
+    src.fail(ptr, plural(static_cast<std::int64_t>(w.size()), "weight") + "; expected " +
+                      std::to_string(count) + " (one per control point) or null");
+  for (std::size_t i = 0; i < w.size(); ++i)
+    if (!(w[i] > 0))
+      src.fail(child(ptr, i), "weight " + format_double(w[i]) + "; expected a positive weight");
+  return w;
+}
+
+template <int P>
+spline::TensorSpline<P> read_spline(const Source& src, const json& j, const std::string& ptr,
+                                    const PointShape& shape) {
+  const char* kind = P == 3 ? "a trivariate" : "a surface";
+  const std::string what = std::string(kind) + " {\"orders\", \"knots\", \"points\", \"weights\"}";
+  expect_object(src, j, ptr, what);
+  const auto orders =
+      read_orders<P>(src, require(src, j, ptr, "orders", what), child(ptr, "orders"));
+  const std::string kp = child(ptr, "knots");
+  const json& kj = expect_array(src, require(src, j, ptr, "knots", what), kp,
+                                std::to_string(P) + " knot vectors, one per direction");
+  if (kj.size() != P)
+    src.fail(kp, plural(static_cast<std::int64_t>(kj.size()), "knot vector") + "; expected " +
+                     std::to_string(P) + ", one per direction");
+  std::array<KnotVector, P> knots;
+  std::int64_t count = 1;
+  std::string counts_text;
+  for (int d = 0; d < P; ++d) {
+    knots[d] = read_knot_vector(src, kj[d], child(kp, d), orders[d]);
+    count = saturating_product(count, knots[d].size());
+    counts_text += (d ? " x " : "") + std::to_string(knots[d].size());
+  }
+  const std::string count_text =
+      std::to_string(count) + " (" + counts_text + ", from the knot vectors and orders)";
+  auto points = read_points(src, require(src, j, ptr, "points", what), child(ptr, "points"), count,
+                            count_text, shape);
+  auto weights = read_weights(src, find(j, "weights"), child(ptr, "weights"), count);
+  try {
+    return spline::TensorSpline<P>(std::move(knots), shape.dim, std::move(points),
+                                   std::move(weights));
+  } catch (const Error& e) {
+    throw e.within(src.at(ptr));
+  }
+}
+
+// ------------------------------------------------------------------------------------------
+// The model
+
+constexpr const char* scene_message =
+    "this is a scene (primitives/operations); expected a model, whose cells are all "
+    "trivariates: run `trivox build SCENE -o MODEL` to turn the scene into one";
+
+void check_version(const Source& src, const json& root) {
+  const json& v = require(src, root, "", "trivox",
+                          "\"trivox\": 1 (the model format version) in a trivox model file");
+  if (!v.is_number()) fail_type(src, "/trivox", v, "the format version 1");
+  if (v != model_format_version)
+    src.fail("/trivox", "format version " + v.dump() +
+                            "; expected 1 (this trivox reads model format version 1)");
+}
+
+/// Scenes are recognised before anything else so that they get the `build` hint, not a
+/// complaint about a missing trivariate.
+void reject_scene(const Source& src, const json& root) {
+  if (const json* ops = find(root, "operations")) {
+    expect_array(src, *ops, "/operations", "an array of operations (empty in a model)");
+    if (!ops->empty()) src.fail("/operations", scene_message);
+  }
+  const json* cells = find(root, "cells");
+  if (cells == nullptr || !cells->is_array()) return;
+  for (std::size_t i = 0; i < cells->size(); ++i)
+    if ((*cells)[i].is_object() && (*cells)[i].contains("primitive"))
+      src.fail(child(child("/cells", i), "primitive"), scene_message);
+}
+
+std::string read_units(const Source& src, const json& root) {
+  const json* j = find(root, "units");
+  if (j == nullptr) return "mm";
+  const std::string what = "one of \"um\", \"mm\", \"cm\", \"m\", \"in\"";
+  const std::string units = read_string(src, *j, "/units", what);
+  if (!known_units(units))
+    src.fail("/units", "unknown units " + quote(units) + "; expected " + what);
+  return units;
+}
+
+std::vector<std::string> read_properties(const Source& src, const json& root) {
+  const json* j = find(root, "properties");
+  if (j == nullptr || j->is_null()) return {};
+  const std::string what = "a unique non-empty property name";
+  expect_array(src, *j, "/properties", "an array of property names");
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string p = child("/properties", i);
+    std::string name = read_string(src, (*j)[i], p, what);
+    if (name.empty()) src.fail(p, "empty name; expected " + what);
+    for (std::size_t k = 0; k < out.size(); ++k)
+      if (out[k] == name)
+        src.fail(p,
+                 quote(name) + " repeats /properties/" + std::to_string(k) + "; expected " + what);
+    out.push_back(std::move(name));
+  }
+  return out;
+}
+
+/// Names taken so far (cells and surfaces share one namespace), with their owner's pointer.
+using NameTable = std::map<std::string, std::string>;
+
+std::string read_name(const Source& src, const json& obj, const std::string& ptr,
+                      NameTable& names) {
+  const std::string what = "a unique non-empty name";
+  const std::string np = child(ptr, "name");
+  std::string name = read_string(src, require(src, obj, ptr, "name", what), np, what);
+  if (name.empty()) src.fail(np, "empty name; expected " + what);
+  const auto [it, fresh] = names.emplace(name, ptr);
+  if (!fresh)
+    src.fail(np, quote(name) + " is also the name of " + it->second + "; expected " + what);
+  return name;
+}
+
+/// One array of named splines: "cells" (key "trivariate") or "surfaces" (key "surface").
+template <int P, class Item>
+std::vector<Item> read_items(const Source& src, const json& root, const char* list, const char* key,
+                             const PointShape& shape, NameTable& names) {
+  const json* j = find(root, list);
+  if (j == nullptr) return {};
+  const std::string lp = std::string("/") + list;
+  const std::string what = std::string("{\"name\", \"") + key + "\"}";
+  expect_array(src, *j, lp, "an array of " + what + " objects");
+  std::vector<Item> out;
+  out.reserve(j->size());
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string ip = child(lp, i);
+    const json& item = expect_object(src, (*j)[i], ip, "an object " + what);
+    std::string name = read_name(src, item, ip, names);
+    out.push_back({std::move(name),
+                   read_spline<P>(src, require(src, item, ip, key, what), child(ip, key), shape)});
+  }
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------
+// Writing
+
+constexpr const char* cannot_write = "cannot write the model: ";
+
+/// The header checks of check_writable: content, units and property names.
+void check_header(const vmodel::VModel& m) {
+  if (m.cells.empty() && m.surfaces.empty())
+    throw Error(std::string(cannot_write) + "no cells and no surfaces; expected at least one");
+  if (!known_units(m.units))
+    throw Error(cannot_write + ("unknown units " + quote(m.units)) +
+                "; expected um, mm, cm, m or in");
+  for (std::size_t i = 0; i < m.properties.size(); ++i)
+    for (std::size_t k = 0; k <= i; ++k)
+      if (m.properties[i].empty() || (k < i && m.properties[k] == m.properties[i]))
+        throw Error(cannot_write + ("property " + std::to_string(i)) + " is " +
+                    quote(m.properties[i]) + "; expected unique non-empty names");
+}
+
+/// One cell or surface: a fresh name, the model's dimension, finite values.
+template <int P>
+void check_item(const std::string& name, const spline::TensorSpline<P>& s, const PointShape& shape,
+                NameTable& names) {
+  const std::string pre = cannot_write + quote(name);
+  if (name.empty() || !names.emplace(name, "").second)
+    throw Error(cannot_write + ("name " + quote(name)) + "; expected unique non-empty names");
+  if (s.dim() != shape.dim)
+    throw Error(pre + " has " + plural(s.dim(), "coordinate") + " per control point; expected " +
+                shape.text);
+  for (double v : s.points())
+    if (!std::isfinite(v))
+      throw Error(pre + " has a non-finite coordinate; expected finite numbers");
+  for (double w : s.weights())
+    if (!(w > 0) || !std::isfinite(w))
+      throw Error(pre + " has weight " + format_double(w) + "; expected positive finite weights");
+}
+
+/// Everything the reader would reject, checked before a byte is written.
+void check_writable(const vmodel::VModel& m) {
+  check_header(m);
+  const PointShape shape = point_shape(m.properties.size());
+  NameTable names;
+  for (const auto& c : m.cells) check_item(c.name, c.volume, shape, names);
+  for (const auto& s : m.surfaces) check_item(s.name, s.surface, shape, names);
+}
+
+void write_numbers(std::string& out, std::span<const double> values) {
+  out += '[';
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i) out += ", ";
+    out += format_double(values[i]);
+  }
+  out += ']';
+}
+
+/// A spline object at the given indentation, one knot vector and one control point per line,
+/// weights one u-row per line.
+template <int P>
+void write_spline(std::string& out, const spline::TensorSpline<P>& s, const std::string& indent) {
+  const std::string in1 = indent + "  ", in2 = indent + "    ";
+  out += "{\n" + in1 + "\"orders\": [";
+  for (int d = 0; d < P; ++d) out += (d ? ", " : "") + std::to_string(s.knots(d).order());
+  out += "],\n" + in1 + "\"knots\": [";
+  for (int d = 0; d < P; ++d) {
+    out += (d ? ",\n" : "\n") + in2;
+    write_numbers(out, s.knots(d).knots());
+  }
+  out += "\n" + in1 + "],\n" + in1 + "\"points\": [";
+  for (int r = 0; r < s.size(); ++r) {
+    out += (r ? ",\n" : "\n") + in2;
+    write_numbers(out, s.point(r));
+  }
+  out += "\n" + in1 + "],\n" + in1 + "\"weights\": ";
+  if (!s.rational()) {
+    out += "null";
+  } else {
+    const auto row = static_cast<std::size_t>(s.count(0));
+    const std::span<const double> w = s.weights();
+    out += '[';
+    for (std::size_t i = 0; i < w.size(); ++i)
+      out += (i == 0 ? "\n" + in2 : i % row == 0 ? ",\n" + in2 : ", ") + format_double(w[i]);
+    out += "\n" + in1 + "]";
+  }
+  out += "\n" + indent + "}";
+}
+
+template <class Item, class Get>
+void write_items(std::string& out, const std::vector<Item>& items, const char* list,
+                 const char* key, Get get) {
+  out += std::string("  \"") + list + "\": [";
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    out += (i ? ",\n" : "\n");
+    out += "    {\n      \"name\": " + quote(items[i].name) + ",\n      \"" + key + "\": ";
+    write_spline(out, get(items[i]), "      ");
+    out += "\n    }";
+  }
+  out += items.empty() ? "],\n" : "\n  ],\n";
+}
+
+}  // namespace
+
+bool known_units(std::string_view units) noexcept {
+  for (auto u : units_list)
+    if (u == units) return true;
+  return false;
+}
+
+vmodel::VModel read_model_json(std::string_view text, const std::string& source) {
+  const Source src{source};
+  const json root = parse(src, text);
+  expect_object(src, root, "", "a trivox model object {\"trivox\": 1, ...}");
+  check_version(src, root);
+  reject_scene(src, root);
+  vmodel::VModel model;
+  model.units = read_units(src, root);
+  model.properties = read_properties(src, root);
+  const PointShape shape = point_shape(model.properties.size());
+  NameTable names;
+  model.cells = read_items<3, vmodel::VCell>(src, root, "cells", "trivariate", shape, names);
+  model.surfaces =
+      read_items<2, vmodel::NamedSurface>(src, root, "surfaces", "surface", shape, names);
+  if (model.cells.empty() && model.surfaces.empty())
+    src.fail("",
+             "no cells and no surfaces; expected at least one cell (\"cells\") or "
+             "surface (\"surfaces\")");
+  return model;
+}
+
+std::string write_model_json(const vmodel::VModel& model) {
+  check_writable(model);
+  std::string out = "{\n  \"trivox\": " + std::to_string(model_format_version) +
+                    ",\n  \"units\": " + quote(model.units) + ",\n  \"properties\": [";
+  for (std::size_t i = 0; i < model.properties.size(); ++i)
+    out += (i ? ", " : "") + quote(model.properties[i]);
+  out += "],\n";
+  write_items(out, model.cells, "cells", "trivariate",
+              [](const vmodel::VCell& c) -> const spline::Trivariate& { return c.volume; });
+  if (!model.surfaces.empty())
+    write_items(out, model.surfaces, "surfaces", "surface",
+                [](const vmodel::NamedSurface& s) -> const spline::Surface& { return s.surface; });
+  out += "  \"operations\": []\n}\n";
+  return out;
+}
+
+}  // namespace trivox::io
