@@ -40,6 +40,17 @@ KnotVector::KnotVector(int order, std::vector<double> knots) : order_(order), kn
     if (knots_[i] == knots_[i + order_])
       throw Error("knot value " + num(knots_[i]) + " repeated more than " + std::to_string(order_) +
                   " times from knot " + std::to_string(i) + "; expected multiplicity <= order");
+  // Reciprocal knot differences per span for the divisions of Cox-de Boor (zero for empty spans,
+  // which find_span never returns).
+  const int p = order_ - 1, tri = p * (p + 1) / 2;
+  inv_.assign(static_cast<std::size_t>((size() - p) * tri), 0.0);
+  for (int mu = p; mu < size(); ++mu) {
+    if (!(knots_[static_cast<std::size_t>(mu)] < knots_[static_cast<std::size_t>(mu) + 1])) continue;
+    double* iv = inv_.data() + (mu - p) * tri;
+    for (int j = 1; j <= p; ++j)
+      for (int r = 0; r < j; ++r)
+        iv[j * (j - 1) / 2 + r] = 1.0 / (knots_[static_cast<std::size_t>(mu + r + 1)] - knots_[static_cast<std::size_t>(mu + 1 - j + r)]);
+  }
 }
 
 KnotVector KnotVector::uniform(int order, int segments, double a, double b) {
@@ -114,16 +125,19 @@ namespace {
 
 /// Cox-de Boor up to degree p (NURBS Book A2.2, with the left/right differences) on knots `k`
 /// around span mu; `P` = p when known at compile time (the loops unroll), else -1.
+/// `iv`: the span's reciprocal knot differences 1 / (t_{mu+r+1} - t_{mu+1-j+r}) at
+/// [j(j-1)/2 + r], which equal 1 / (R[r+1] + L[j-r]) for every t: no division per evaluation.
 template <int Pc>
-inline void cox_de_boor(const double* k, int mu, double t, int p, double* out, double* L, double* R) {
+inline void cox_de_boor(const double* k, const double* iv, int mu, double t, int p, double* out, double* L, double* R) {
   if constexpr (Pc >= 0) p = Pc;
   out[0] = 1.0;
   for (int j = 1; j <= p; ++j) {
     L[j] = t - k[mu + 1 - j];
     R[j] = k[mu + j] - t;
     double saved = 0.0;
+    const double* ivj = iv + j * (j - 1) / 2;
     for (int r = 0; r < j; ++r) {
-      const double tmp = out[r] / (R[r + 1] + L[j - r]);
+      const double tmp = out[r] * ivj[r];
       out[r] = saved + R[r + 1] * tmp;
       saved = L[j - r] * tmp;
     }
@@ -135,15 +149,17 @@ inline void cox_de_boor(const double* k, int mu, double t, int p, double* out, d
 /// N'_{i,p} = p (M_{i-1} / (t_{i+p} - t_i) - M_i / (t_{i+p+1} - t_{i+1})) (NURBS Book eq. 2.9)
 /// and the last Cox-de Boor step for the values.
 template <int Pc>
-inline void values_and_slopes(const double* k, int mu, double t, int p, double* out, double* L, double* R) {
+inline void values_and_slopes(const double* k, const double* iv, int mu, double t, int p, double* out, double* L, double* R) {
   if constexpr (Pc >= 0) p = Pc;
   double* val = out;
   double* der = out + p + 1;
-  cox_de_boor<(Pc > 0 ? Pc - 1 : -1)>(k, mu, t, p - 1, val, L, R);
-  // der_j from M_{j-1}, M_j (val holds M_0..M_{p-1}).
+  cox_de_boor<(Pc > 0 ? Pc - 1 : -1)>(k, iv, mu, t, p - 1, val, L, R);
+  // der_j from M_{j-1}, M_j (val holds M_0..M_{p-1}); 1 / (t_{mu+j+1} - t_{mu-p+j+1}) is row p
+  // of the reciprocal table.
+  const double* ivp = iv + p * (p - 1) / 2;
   double prev = 0.0;  // M_{j-1} / (t_{mu+j} - t_{mu-p+j})
   for (int j = 0; j < p; ++j) {
-    const double q = val[j] / (k[mu + j + 1] - k[mu - p + j + 1]);
+    const double q = val[j] * ivp[j];
     der[j] = p * (prev - q);
     prev = q;
   }
@@ -153,7 +169,7 @@ inline void values_and_slopes(const double* k, int mu, double t, int p, double* 
   R[p] = k[mu + p] - t;
   double saved = 0.0;
   for (int r = 0; r < p; ++r) {
-    const double tmp = val[r] / (R[r + 1] + L[p - r]);
+    const double tmp = val[r] * ivp[r];
     val[r] = saved + R[r + 1] * tmp;
     saved = L[p - r] * tmp;
   }
@@ -166,18 +182,19 @@ void KnotVector::basis(int span, double t, double* out) const noexcept {
   const int p = order_ - 1;
   double L[16], R[16];
   const double* k = knots_.data();
+  const double* iv = span_reciprocals(span);
   switch (p) {
     case 0: out[0] = 1.0; return;
-    case 1: return cox_de_boor<1>(k, span, t, p, out, L, R);
-    case 2: return cox_de_boor<2>(k, span, t, p, out, L, R);
-    case 3: return cox_de_boor<3>(k, span, t, p, out, L, R);
-    case 4: return cox_de_boor<4>(k, span, t, p, out, L, R);
-    case 5: return cox_de_boor<5>(k, span, t, p, out, L, R);
+    case 1: return cox_de_boor<1>(k, iv, span, t, p, out, L, R);
+    case 2: return cox_de_boor<2>(k, iv, span, t, p, out, L, R);
+    case 3: return cox_de_boor<3>(k, iv, span, t, p, out, L, R);
+    case 4: return cox_de_boor<4>(k, iv, span, t, p, out, L, R);
+    case 5: return cox_de_boor<5>(k, iv, span, t, p, out, L, R);
     default: break;
   }
-  if (p < 16) return cox_de_boor<-1>(k, span, t, p, out, L, R);
+  if (p < 16) return cox_de_boor<-1>(k, iv, span, t, p, out, L, R);
   std::vector<double> heap(2 * static_cast<std::size_t>(p + 1));
-  cox_de_boor<-1>(k, span, t, p, out, heap.data(), heap.data() + p + 1);
+  cox_de_boor<-1>(k, iv, span, t, p, out, heap.data(), heap.data() + p + 1);
 }
 
 void KnotVector::basis_derivatives(int span, double t, int nder, double* out) const noexcept {
@@ -189,12 +206,13 @@ void KnotVector::basis_derivatives(int span, double t, int nder, double* out) co
     // The common case (first partials) without the full derivative triangle.
     double L[16], R[16];
     const double* k = knots_.data();
+    const double* iv = span_reciprocals(span);
     switch (p) {
-      case 1: return values_and_slopes<1>(k, span, t, p, out, L, R);
-      case 2: return values_and_slopes<2>(k, span, t, p, out, L, R);
-      case 3: return values_and_slopes<3>(k, span, t, p, out, L, R);
-      case 4: return values_and_slopes<4>(k, span, t, p, out, L, R);
-      default: return values_and_slopes<-1>(k, span, t, p, out, L, R);
+      case 1: return values_and_slopes<1>(k, iv, span, t, p, out, L, R);
+      case 2: return values_and_slopes<2>(k, iv, span, t, p, out, L, R);
+      case 3: return values_and_slopes<3>(k, iv, span, t, p, out, L, R);
+      case 4: return values_and_slopes<4>(k, iv, span, t, p, out, L, R);
+      default: return values_and_slopes<-1>(k, iv, span, t, p, out, L, R);
     }
   }
   const int requested = nder;

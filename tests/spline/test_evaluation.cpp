@@ -198,3 +198,19 @@ TEST_CASE("the coherent Evaluator equals plain evaluation on scanlines and rando
     }
   CHECK(w2 < 1e-13);
 }
+
+TEST_CASE("batch evaluation equals point evaluation and checks its sizes") {
+  const auto f = TensorPoly<3>::random({3, 3, 2}, 4, 51);
+  const auto s = f.spline({test_knots(4, 52), test_knots(4, 53), test_knots(3, 54)});
+  const auto ts = trivox::test::random_params(s, 5000, 55);
+  std::vector<double> params;
+  for (const auto& t : ts) params.insert(params.end(), t.begin(), t.end());
+  std::vector<double> out(ts.size() * 4);
+  s.eval_many(params, out);
+  for (std::size_t i = 0; i < ts.size(); ++i) {
+    const auto v = s.eval(ts[i]);
+    for (std::size_t h = 0; h < 4; ++h) REQUIRE(out[i * 4 + h] == v[h]);  // same arithmetic, bit for bit
+  }
+  std::vector<double> wrong(7);
+  CHECK_THROWS_WITH(s.eval_many(params, wrong), Catch::Contains("expected n x 3"));
+}

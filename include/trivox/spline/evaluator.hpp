@@ -34,7 +34,7 @@ public:
 private:
   struct Basis1 {
     int first = 0;
-    double N[2][16] = {};  // values, first derivatives (order <= 16 on the cached path)
+    double N[2][16];  // values, first derivatives (order <= 16 on the cached path); filled by basis_at
   };
   void basis_at(int d, double t, bool derivs, Basis1& b);
   void build_line(const Params& t, bool derivs);

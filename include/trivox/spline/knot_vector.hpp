@@ -78,11 +78,19 @@ public:
   /// Greville abscissae: the averages of the knots t_{i+1}..t_{i+order-1}, one per function.
   std::vector<double> greville() const;
 
-  bool operator==(const KnotVector&) const = default;
+  bool operator==(const KnotVector& o) const noexcept { return order_ == o.order_ && knots_ == o.knots_; }
 
 private:
+  const double* span_reciprocals(int span) const noexcept {
+    const int p = order_ - 1;
+    return inv_.data() + (span - p) * (p * (p + 1) / 2);
+  }
+
   int order_ = 0;
   std::vector<double> knots_;
+  /// Per non-empty span mu: 1 / (t_{mu+r+1} - t_{mu+1-j+r}) for j = 1..degree, r < j, the
+  /// denominators of Cox-de Boor, which do not depend on the parameter.
+  std::vector<double> inv_;
 };
 
 }  // namespace trivox::spline
