@@ -1,5 +1,7 @@
 #include "trivox/io/model_file.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -115,12 +117,44 @@ ModelFormat detect_model_format(std::string_view text, const std::string& source
   throw Error(source + ": the file starts with " + shown + "; " + expected);
 }
 
+namespace {
+
+/// Coordinates beyond this magnitude (in model units: a million kilometres in mm) are refused:
+/// volumes multiply three of them, and 1e300 cubed is no longer a number.
+constexpr double max_coordinate = 1e12;
+
+std::string format_magnitude(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+template <int P>
+void check_magnitudes(const spline::TensorSpline<P>& s, const std::string& where, bool json) {
+  const int dim = s.dim();
+  for (int r = 0; r < s.size(); ++r)
+    for (int h = 0; h < dim; ++h) {
+      const double v = s.point(r)[static_cast<std::size_t>(h)];
+      if (std::abs(v) > max_coordinate)
+        throw Error(where + (json ? "/points/" + std::to_string(r) + "/" + std::to_string(h)
+                                  : " control point " + std::to_string(r) + " coordinate " + std::to_string(h)) +
+                    ": " + format_magnitude(v) + "; expected a magnitude of at most 1e12 model units");
+    }
+}
+
+}  // namespace
+
 vmodel::VModel read_model(std::string_view text, const std::string& source) {
-  switch (detect_model_format(text, source)) {
-    case ModelFormat::json: return read_model_json(text, source);
-    case ModelFormat::gismo_xml: return read_gismo_xml(text, source);
-  }
-  throw Error(source + ": unknown model format; expected JSON or G+Smo XML");
+  const ModelFormat format = detect_model_format(text, source);
+  vmodel::VModel m = format == ModelFormat::json ? read_model_json(text, source) : read_gismo_xml(text, source);
+  const bool json = format == ModelFormat::json;
+  for (std::size_t i = 0; i < m.cells.size(); ++i)
+    check_magnitudes(m.cells[i].volume,
+                     source + ": " + (json ? "/cells/" + std::to_string(i) + "/trivariate" : m.cells[i].name), json);
+  for (std::size_t i = 0; i < m.surfaces.size(); ++i)
+    check_magnitudes(m.surfaces[i].surface,
+                     source + ": " + (json ? "/surfaces/" + std::to_string(i) + "/surface" : m.surfaces[i].name), json);
+  return m;
 }
 
 std::string read_file(const fs::path& path) {

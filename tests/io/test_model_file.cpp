@@ -146,3 +146,12 @@ TEST_CASE("the examples in docs/model-format.md load (or are scenes)", "[io][fil
   CHECK(models == 2);
   CHECK(scenes == 1);
 }
+
+TEST_CASE("coordinates of absurd magnitude are refused with their place") {
+  const std::string text = R"({"trivox": 1, "cells": [{"name": "c", "trivariate": {"orders": [2, 2, 2],
+    "knots": [[0, 0, 1, 1], [0, 0, 1, 1], [0, 0, 1, 1]],
+    "points": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [0, 0, 1], [1, 0, 1], [0, 1, 1], [1, 1, 1e300]]}}]})";
+  CHECK_THROWS_WITH(trivox::io::read_model(text, "big.json"),
+                    Catch::Contains("big.json: /cells/0/trivariate/points/7/2") &&
+                        Catch::Contains("expected a magnitude of at most 1e12"));
+}
