@@ -17,6 +17,10 @@ struct Common {
 /// Each subcommand file defines one of these; main.cpp calls them in order.
 void add_info(CLI::App& app, Common& common);
 void add_eval(CLI::App& app, Common& common);
+void add_locate(CLI::App& app, Common& common);
+void add_slice(CLI::App& app, Common& common);
+void add_inspect(CLI::App& app, Common& common);
+void add_preview(CLI::App& app, Common& common);
 
 /// Parses "a,b,c" into exactly `count` finite numbers.
 /// @param option  the option's name, for the message ("--uvw")

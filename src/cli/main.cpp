@@ -17,6 +17,10 @@ int main(int argc, char** argv) {
   trivox::cli::Common common;
   trivox::cli::add_info(app, common);
   trivox::cli::add_eval(app, common);
+  trivox::cli::add_locate(app, common);
+  trivox::cli::add_slice(app, common);
+  trivox::cli::add_inspect(app, common);
+  trivox::cli::add_preview(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
