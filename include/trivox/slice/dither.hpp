@@ -1,0 +1,103 @@
+/// @file trivox/slice/dither.hpp
+/// @brief Halftoning material fractions into one material per voxel, layer by layer.
+///
+/// Each voxel of a layer carries a vector of material fractions (MaterialMapper); the printer
+/// deposits one material per voxel. LayerDitherer chooses it so that, over any region of
+/// constant fractions, each material's share of the voxels matches its fraction:
+/// - `fs`: vector error diffusion (Floyd & Steinberg 1976, generalised to a simplex of
+///   materials): the voxel takes the material with the largest error-corrected fraction among
+///   those present in its own fraction vector (ties: the lowest index), and the difference
+///   (corrected - chosen one-hot) goes to the unvisited neighbours with FS weights rescaled
+///   for the voxel's aspect ratio (diffusion_weights). Rows are visited in serpentine order
+///   (even rows left to right). Void voxels neither receive nor pass error: the weights are
+///   renormalised over the neighbours inside the layer that are not void in the current row,
+///   and error reaching a void voxel of the next row (whose voids are not known yet when the
+///   error is sent) is discarded there.
+/// - `stochastic`: the material drawn by inverse CDF from a uniform number hashed from
+///   (seed, layer, row, column): independent of banding, threads and visiting order.
+/// - `none`: the largest fraction (ties: the lowest index).
+/// docs/materials.md gives the maths.
+///
+/// Bands: a layer's rows arrive in successive dither() calls with increasing row0; error
+/// diffusion carries its state across calls, so the output does not depend on how a layer is
+/// split into bands. Rows skipped between two calls count as void rows.
+///
+/// Cost: O(materials) per non-void voxel (about 8 flops per material for `fs`, in 4-wide vectors
+/// up to 8 materials), O(1) per void voxel; no allocation after construction; memory for `fs`
+/// 2 (nx + 2) s floats, s = materials (rounded up to a multiple of 4 when at most 8). One LayerDitherer per thread: it holds the
+/// error state of the layer in progress.
+#pragma once
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+namespace trivox::slice {
+
+enum class DitherMode { fs, stochastic, none };
+
+/// "fs", "stochastic" or "none".
+/// @throws trivox::Error (bad_input) "--dither X: expected fs, stochastic or none"
+DitherMode parse_dither_mode(std::string_view text);
+/// The option text of a mode (inverse of parse_dither_mode).
+std::string_view dither_mode_name(DitherMode mode) noexcept;
+
+/// Error-diffusion weights of the four forward neighbours, summing to 1. Row direction is
+/// "forward"; "down" is the next row. Floyd-Steinberg's 7, 3, 5, 1 (/16) for a square voxel,
+/// each scaled by (its neighbour's distance on a square grid) / (its distance on this grid),
+/// then normalised: on the J750's 42.3 x 84.7 um voxel, 0.582, 0.158, 0.208, 0.053.
+struct DiffusionWeights {
+  double forward;       ///< (x + dir, y)
+  double down_back;     ///< (x - dir, y + 1)
+  double down;          ///< (x, y + 1)
+  double down_forward;  ///< (x + dir, y + 1)
+};
+/// @param pitch_x, pitch_y  voxel size along a row and from row to row (any unit, > 0)
+/// @throws trivox::Error (bad_input) on non-finite or non-positive pitches
+DiffusionWeights diffusion_weights(double pitch_x, double pitch_y);
+
+/// Chooses one material per voxel, a layer at a time (see the file comment).
+class LayerDitherer {
+public:
+  /// @param mode       fs, stochastic or none
+  /// @param nx         voxels per row (>= 1)
+  /// @param materials  length of each voxel's fraction vector (1..254)
+  /// @param pitch_x    voxel size along a row (mm), for the fs weights
+  /// @param pitch_y    row-to-row distance (mm)
+  /// @param seed       varies the stochastic pattern (fs and none ignore it)
+  /// @throws trivox::Error (bad_input) on nx < 1, materials outside 1..254, bad pitches
+  LayerDitherer(DitherMode mode, int nx, int materials, double pitch_x, double pitch_y, std::uint64_t seed = 0);
+
+  /// Starts layer `layer` (the stochastic hash uses it): clears the error state.
+  void begin_layer(int layer);
+
+  /// Dithers rows [row0, row0 + rows) of the current layer.
+  /// @param row0       first row; for fs at least the end of the previous call's rows
+  /// @param rows       number of rows (>= 0)
+  /// @param cell       rows * nx values, row-major; < 0 marks a void voxel
+  /// @param fractions  rows * nx * materials floats, voxel-major: non-negative, summing to 1
+  ///                   (MaterialMapper::fractions); not read for void voxels. A voxel whose
+  ///                   fractions are all zero gets material 0.
+  /// @param out        rows * nx material indices written; void_material (255) for void voxels
+  /// @throws trivox::Error (failed) when fs rows go backwards (row0 below the previous end)
+  void dither(int row0, int rows, const std::int32_t* cell, const float* fractions, std::uint8_t* out);
+
+  DitherMode mode() const noexcept { return mode_; }
+  int nx() const noexcept { return nx_; }
+  int materials() const noexcept { return materials_; }
+
+private:
+  void fs_row(int row, const std::int32_t* cell, const float* fractions, std::uint8_t* out);
+  void stochastic_row(int row, const std::int32_t* cell, const float* fractions, std::uint8_t* out) const;
+  void none_row(const std::int32_t* cell, const float* fractions, std::uint8_t* out) const;
+
+  DitherMode mode_;
+  int nx_, materials_;
+  std::uint64_t seed_;
+  int layer_ = 0;
+  int next_row_ = 0;            // first row the next fs call may start at
+  float weights_[8][4] = {};    // per neighbour-availability mask: forward, down_back, down, down_forward
+  std::vector<float> error_;    // 2 halves of (nx + 2) * stride: incoming error of a row, and of the next
+  std::vector<float> scratch_;  // corrected fractions and the in-row carry (runtime-count kernel)
+};
+
+}  // namespace trivox::slice

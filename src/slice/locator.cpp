@@ -1,0 +1,1065 @@
+#include "trivox/slice/locator.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <utility>
+
+#include "trivox/error.hpp"
+#include "trivox/spline/extract.hpp"
+#include "trivox/spline/refine.hpp"
+
+namespace trivox::slice {
+
+namespace {
+
+constexpr int max_order = 16;
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------------------------
+// Bernstein evaluation. A piece's geometry is kept as a net of H = 3 (polynomial) or 4 (rational,
+// homogeneous wx wy wz w) coordinates per control point, u fastest; its properties as a separate
+// net of m coordinates (pre-multiplied by the weight when rational), so Newton never touches them.
+
+/// Bernstein polynomials of order n (degree n-1) at s and, when dB is not null, their derivatives.
+template <int O>
+inline void bernstein(int order, double s, double* B, double* dB) {
+  const int n = O ? O : order;
+  if (n == 1) {
+    B[0] = 1.0;
+    if (dB) dB[0] = 0.0;
+    return;
+  }
+  const double s1 = 1.0 - s;
+  double b[O ? O : max_order];  // degree n-2 values
+  b[0] = 1.0;
+  for (int k = 1; k < n - 1; ++k) {
+    b[k] = s * b[k - 1];
+    for (int j = k - 1; j >= 1; --j) b[j] = s1 * b[j] + s * b[j - 1];
+    b[0] *= s1;
+  }
+  if (dB) {
+    const double deg = n - 1;
+    dB[0] = -deg * b[0];
+    for (int j = 1; j < n - 1; ++j) dB[j] = deg * (b[j - 1] - b[j]);
+    dB[n - 1] = deg * b[n - 2];
+  }
+  B[n - 1] = s * b[n - 2];
+  for (int j = n - 2; j >= 1; --j) B[j] = s1 * b[j] + s * b[j - 1];
+  B[0] = s1 * b[0];
+}
+
+/// Geometry kernel: the first H coordinates of every control point (points `nc` coordinates
+/// apart) contracted with the Bernstein basis: f = the value (H numbers) and, when D, the partials
+/// in the piece's local parameters (3 x H more). Contracts u, then v, then w, so the partials cost
+/// O(o^3 H) together. O: uniform order known at compile time (0: read from ord).
+template <int O, int H, bool D, int NS = 0>
+void geom_kernel(const double* net, int stride, const std::array<int, 3>& ord, const double* s, double* f) {
+  constexpr int M = O ? O : max_order;
+  const int nc = NS ? NS : stride;  // coordinates per control point (compile-time when NS > 0)
+  const int ou = O ? O : ord[0], ov = O ? O : ord[1], ow = O ? O : ord[2];
+  double Bu[M], Bv[M], Bw[M], dBu[D ? M : 1], dBv[D ? M : 1], dBw[D ? M : 1];
+  bernstein<O>(ou, s[0], Bu, D ? dBu : nullptr);
+  bernstein<O>(ov, s[1], Bv, D ? dBv : nullptr);
+  bernstein<O>(ow, s[2], Bw, D ? dBw : nullptr);
+  double S[H] = {}, Su[H] = {}, Sv[H] = {}, Sw[H] = {};
+  for (int c = 0; c < ow; ++c) {
+    double T[H] = {}, Tu[H] = {}, Tv[H] = {};
+    for (int b = 0; b < ov; ++b) {
+      const double* row = net + static_cast<std::ptrdiff_t>((c * ov + b) * ou) * nc;
+      double r[H] = {}, ru[H] = {};
+      for (int a = 0; a < ou; ++a)
+        for (int h = 0; h < H; ++h) {
+          r[h] += Bu[a] * row[a * nc + h];
+          if constexpr (D) ru[h] += dBu[a] * row[a * nc + h];
+        }
+      for (int h = 0; h < H; ++h) {
+        T[h] += Bv[b] * r[h];
+        if constexpr (D) {
+          Tu[h] += Bv[b] * ru[h];
+          Tv[h] += dBv[b] * r[h];
+        }
+      }
+    }
+    for (int h = 0; h < H; ++h) {
+      S[h] += Bw[c] * T[h];
+      if constexpr (D) {
+        Su[h] += Bw[c] * Tu[h];
+        Sv[h] += Bw[c] * Tv[h];
+        Sw[h] += dBw[c] * T[h];
+      }
+    }
+  }
+  for (int h = 0; h < H; ++h) {
+    f[h] = S[h];
+    if constexpr (D) {
+      f[H + h] = Su[h];
+      f[2 * H + h] = Sv[h];
+      f[3 * H + h] = Sw[h];
+    }
+  }
+}
+
+/// Value kernel: all nc coordinates of the net at s (geometry and properties in one pass),
+/// contracted u, then v, then w, so the sums form short independent chains (instruction-level
+/// parallelism) rather than one chain of order^3 terms per coordinate.
+/// NC: coordinates known at compile time (0: nc, in chunks).
+template <int O, int NC>
+void value_kernel(const double* net, int nc, const std::array<int, 3>& ord, const double* s, double* f) {
+  constexpr int M = O ? O : max_order;
+  const int ou = O ? O : ord[0], ov = O ? O : ord[1], ow = O ? O : ord[2];
+  double Bu[M], Bv[M], Bw[M];
+  bernstein<O>(ou, s[0], Bu, nullptr);
+  bernstein<O>(ov, s[1], Bv, nullptr);
+  bernstein<O>(ow, s[2], Bw, nullptr);
+  constexpr int chunk = NC ? NC : 16;
+  const int n = NC ? NC : nc;  // NC, when given, equals nc: a compile-time stride
+  for (int h0 = 0; h0 < n; h0 += chunk) {
+    const int hn = NC ? NC : std::min(chunk, n - h0);
+    double S[chunk] = {};
+    for (int c = 0; c < ow; ++c) {
+      double T[chunk] = {};
+      for (int b = 0; b < ov; ++b) {
+        const double* row = net + static_cast<std::ptrdiff_t>((c * ov + b) * ou) * n + h0;
+        double r[chunk] = {};
+        for (int a = 0; a < ou; ++a)
+          for (int h = 0; h < hn; ++h) r[h] += Bu[a] * row[a * n + h];
+        for (int h = 0; h < hn; ++h) T[h] += Bv[b] * r[h];
+      }
+      for (int h = 0; h < hn; ++h) S[h] += Bw[c] * T[h];
+    }
+    for (int h = 0; h < hn; ++h) f[h0 + h] = S[h];
+  }
+}
+
+using Kernel = void (*)(const double*, int, const std::array<int, 3>&, const double*, double*);
+
+struct Kernels {
+  Kernel first = nullptr;      ///< geometry with first partials
+  Kernel value = nullptr;      ///< geometry value
+  Kernel all = nullptr;        ///< every coordinate's value
+  Kernel all_first = nullptr;  ///< every coordinate with first partials (polynomial, nc <= 10)
+};
+
+template <int O, int H>
+Kernels kernels_for(int nc) {
+  Kernels k{geom_kernel<O, H, true>, geom_kernel<O, H, false>, value_kernel<O, 0>, nullptr};
+  [&]<int... I>(std::integer_sequence<int, I...>) {
+    (((nc == I + 3) ? (k.all = value_kernel<O, I + 3>, k.all_first = H == 3 ? geom_kernel<O, I + 3, true, I + 3> : nullptr, 0) : 0),
+     ...);
+  }(std::make_integer_sequence<int, 8>{});
+  return k;
+}
+
+template <int H>
+Kernels pick_kernels(const std::array<int, 3>& ord, int nc) {
+  if (ord[0] == ord[1] && ord[1] == ord[2]) switch (ord[0]) {
+      case 2: return kernels_for<2, H>(nc);
+      case 3: return kernels_for<3, H>(nc);
+      case 4: return kernels_for<4, H>(nc);
+      default: break;
+    }
+  return kernels_for<0, H>(nc);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bezier restriction (de Casteljau), for building leaves: the net of a piece restricted to a
+// sub-box of its local [0,1]^3.
+
+/// Restricts the Bezier polygon of n points (stride `stride` apart, `H` coordinates) to [a, b].
+void restrict_line(double* P, int n, int stride, int H, double a, double b) {
+  auto at = [&](int i) { return P + static_cast<std::ptrdiff_t>(i) * stride; };
+  if (b < 1.0)  // left part [0, b]
+    for (int k = 1; k < n; ++k)
+      for (int i = n - 1; i >= k; --i)
+        for (int h = 0; h < H; ++h) at(i)[h] = (1.0 - b) * at(i - 1)[h] + b * at(i)[h];
+  const double t = b > 0.0 ? a / b : 0.0;
+  if (t > 0.0)  // right part [t, 1] of what is left
+    for (int k = 1; k < n; ++k)
+      for (int i = 0; i < n - k; ++i)
+        for (int h = 0; h < H; ++h) at(i)[h] = (1.0 - t) * at(i)[h] + t * at(i + 1)[h];
+}
+
+/// The net (H coordinates per point, u fastest) restricted to the local box [lo, hi].
+std::vector<double> restrict_net(const std::vector<double>& net, const std::array<int, 3>& ord, int H, const Vec3& lo,
+                                 const Vec3& hi) {
+  std::vector<double> q = net;
+  const int ou = ord[0], ov = ord[1], ow = ord[2];
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b) restrict_line(q.data() + (c * ov + b) * ou * H, ou, H, H, lo[0], hi[0]);
+  for (int c = 0; c < ow; ++c)
+    for (int a = 0; a < ou; ++a) restrict_line(q.data() + (c * ov * ou + a) * H, ov, ou * H, H, lo[1], hi[1]);
+  for (int b = 0; b < ov; ++b)
+    for (int a = 0; a < ou; ++a) restrict_line(q.data() + (b * ou + a) * H, ow, ou * ov * H, H, lo[2], hi[2]);
+  return q;
+}
+
+/// Cartesian xyz of control point i of a geometry net.
+inline Vec3 cartesian(const double* net, int i, int H) {
+  const double* q = net + static_cast<std::ptrdiff_t>(i) * H;
+  const double w = H == 4 ? q[3] : 1.0;
+  return {q[0] / w, q[1] / w, q[2] / w};
+}
+
+struct Flatness {
+  double deviation = 0.0;  ///< max distance of a control point from the least-squares affine map
+  double diagonal = 0.0;   ///< of the control points' box
+  Vec3 box_lo{}, box_hi{};
+  /// The parallelepiped of the affine map's frame that holds every control point (see LocatorLeaf).
+  Vec3 origin{}, frame_lo{}, frame_hi{};
+  std::array<Vec3, 3> frame{};  ///< rows of the inverse of the affine map's matrix
+};
+
+/// How far a net is from an affine map of its parameters (control points against their Greville
+/// abscissae i / (order - 1), a tensor grid, so the least-squares fit separates per direction),
+/// and the boxes that hold it.
+Flatness flatness(const std::vector<double>& net, const std::array<int, 3>& ord, int H) {
+  const std::size_t n = static_cast<std::size_t>(ord[0] * ord[1] * ord[2]);
+  Flatness f;
+  f.box_lo = {inf, inf, inf};
+  f.box_hi = {-inf, -inf, -inf};
+  std::vector<Vec3> X(n);
+  std::vector<std::array<double, 3>> xi(n);  // Greville abscissae, centred
+  Vec3 mean{};
+  for (std::size_t i = 0; i < n; ++i) {
+    X[i] = cartesian(net.data(), static_cast<int>(i), H);
+    const int idx[3] = {static_cast<int>(i) % ord[0], (static_cast<int>(i) / ord[0]) % ord[1], static_cast<int>(i) / (ord[0] * ord[1])};
+    for (std::size_t d = 0; d < 3; ++d) {
+      xi[i][d] = ord[d] > 1 ? double(idx[d]) / (ord[d] - 1) - 0.5 : 0.0;
+      mean[d] += X[i][d] / static_cast<double>(n);
+      f.box_lo[d] = std::min(f.box_lo[d], X[i][d]);
+      f.box_hi[d] = std::max(f.box_hi[d], X[i][d]);
+    }
+  }
+  std::array<Vec3, 3> A{};  // A[d]: the xyz change per unit of direction d
+  for (std::size_t d = 0; d < 3; ++d) {
+    double den = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      den += xi[i][d] * xi[i][d];
+      for (std::size_t k = 0; k < 3; ++k) A[d][k] += xi[i][d] * (X[i][k] - mean[k]);
+    }
+    if (den > 0.0)
+      for (std::size_t k = 0; k < 3; ++k) A[d][k] /= den;
+  }
+  double diag2 = 0.0;
+  for (std::size_t d = 0; d < 3; ++d) diag2 += (f.box_hi[d] - f.box_lo[d]) * (f.box_hi[d] - f.box_lo[d]);
+  f.diagonal = std::sqrt(diag2);
+  for (std::size_t i = 0; i < n; ++i) {
+    double dev2 = 0.0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double e = X[i][k] - mean[k] - A[0][k] * xi[i][0] - A[1][k] * xi[i][1] - A[2][k] * xi[i][2];
+      dev2 += e * e;
+    }
+    f.deviation = std::max(f.deviation, std::sqrt(dev2));
+  }
+  // Frame: the inverse of [A0 A1 A2] (rows = cross products / det), or the identity when the
+  // affine map is (nearly) degenerate.
+  auto cross = [](const Vec3& a, const Vec3& b) { return Vec3{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; };
+  auto len = [](const Vec3& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); };
+  const Vec3 c0 = cross(A[1], A[2]), c1 = cross(A[2], A[0]), c2 = cross(A[0], A[1]);
+  const double det = A[0][0] * c0[0] + A[0][1] * c0[1] + A[0][2] * c0[2];
+  if (std::abs(det) > 1e-6 * len(A[0]) * len(A[1]) * len(A[2]) && std::isfinite(det)) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      f.frame[0][k] = c0[k] / det;
+      f.frame[1][k] = c1[k] / det;
+      f.frame[2][k] = c2[k] / det;
+    }
+  } else {
+    f.frame = {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
+  }
+  f.origin = mean;
+  f.frame_lo = {inf, inf, inf};
+  f.frame_hi = {-inf, -inf, -inf};
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double c = f.frame[k][0] * (X[i][0] - mean[0]) + f.frame[k][1] * (X[i][1] - mean[1]) + f.frame[k][2] * (X[i][2] - mean[2]);
+      f.frame_lo[k] = std::min(f.frame_lo[k], c);
+      f.frame_hi[k] = std::max(f.frame_hi[k], c);
+    }
+  return f;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Small dense linear algebra.
+
+inline double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline double norm3(const double* a) { return std::sqrt(dot3(a, a)); }
+
+/// Solves J d = r for d, J given by its columns. Falls back to a Levenberg-Marquardt step when J
+/// is (nearly) singular.
+void solve3(const double J[3][3], const double* r, double* d) {
+  // columns J[0], J[1], J[2]; J * d = sum_k d_k J[k]
+  const double c0[3] = {J[1][1] * J[2][2] - J[1][2] * J[2][1], J[1][2] * J[2][0] - J[1][0] * J[2][2],
+                        J[1][0] * J[2][1] - J[1][1] * J[2][0]};  // J[1] x J[2]
+  const double det = dot3(J[0], c0);
+  const double scale = norm3(J[0]) * norm3(J[1]) * norm3(J[2]);
+  if (std::abs(det) > 1e-12 * scale) {
+    // Cramer: d_k = det(J with column k replaced by r) / det
+    const double c1[3] = {J[2][1] * J[0][2] - J[2][2] * J[0][1], J[2][2] * J[0][0] - J[2][0] * J[0][2],
+                          J[2][0] * J[0][1] - J[2][1] * J[0][0]};  // J[2] x J[0]
+    const double c2[3] = {J[0][1] * J[1][2] - J[0][2] * J[1][1], J[0][2] * J[1][0] - J[0][0] * J[1][2],
+                          J[0][0] * J[1][1] - J[0][1] * J[1][0]};  // J[0] x J[1]
+    d[0] = dot3(r, c0) / det;
+    d[1] = dot3(r, c1) / det;
+    d[2] = dot3(r, c2) / det;
+    return;
+  }
+  // (J^T J + mu I) d = J^T r
+  double A[3][3], b[3];
+  double tr = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) A[i][j] = dot3(J[i], J[j]);
+    b[i] = dot3(J[i], r);
+    tr += A[i][i];
+  }
+  const double mu = 1e-9 * tr + std::numeric_limits<double>::min();
+  for (int i = 0; i < 3; ++i) A[i][i] += mu;
+  // Cholesky-free: Cramer on the SPD system
+  const double m0[3] = {A[1][1] * A[2][2] - A[1][2] * A[2][1], A[1][2] * A[2][0] - A[1][0] * A[2][2],
+                        A[1][0] * A[2][1] - A[1][1] * A[2][0]};
+  const double dA = A[0][0] * m0[0] + A[0][1] * m0[1] + A[0][2] * m0[2];
+  if (!(std::abs(dA) > 0.0)) {
+    d[0] = d[1] = d[2] = 0.0;
+    return;
+  }
+  const double m1[3] = {A[2][1] * A[0][2] - A[2][2] * A[0][1], A[2][2] * A[0][0] - A[2][0] * A[0][2],
+                        A[2][0] * A[0][1] - A[2][1] * A[0][0]};
+  const double m2[3] = {A[0][1] * A[1][2] - A[0][2] * A[1][1], A[0][2] * A[1][0] - A[0][0] * A[1][2],
+                        A[0][0] * A[1][1] - A[0][1] * A[1][0]};
+  d[0] = dot3(b, m0) / dA;
+  d[1] = dot3(b, m1) / dA;
+  d[2] = dot3(b, m2) / dA;
+}
+
+/// Least squares over the free columns only (the others' steps are zero): min |sum_free d_k J_k - r|.
+void solve_free(const double J[3][3], const double* r, const bool* free, double* d) {
+  int idx[3], n = 0;
+  for (int k = 0; k < 3; ++k) {
+    d[k] = 0.0;
+    if (free[k]) idx[n++] = k;
+  }
+  if (n == 0) return;
+  if (n == 3) return solve3(J, r, d);
+  if (n == 1) {
+    const double a = dot3(J[idx[0]], J[idx[0]]);
+    if (a > 0.0) d[idx[0]] = dot3(J[idx[0]], r) / a;
+    return;
+  }
+  const double a = dot3(J[idx[0]], J[idx[0]]), b = dot3(J[idx[0]], J[idx[1]]), c = dot3(J[idx[1]], J[idx[1]]);
+  const double ra = dot3(J[idx[0]], r), rb = dot3(J[idx[1]], r);
+  double det = a * c - b * b;
+  const double mu = 1e-12 * (a + c);
+  if (!(det > mu * (a + c))) det = (a + mu) * (c + mu) - b * b;
+  if (!(det > 0.0)) return;
+  d[idx[0]] = (c * ra - b * rb) / det;
+  d[idx[1]] = (a * rb - b * ra) / det;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+struct Locator::Data {
+  struct Piece {
+    int cell = 0;
+    std::array<int, 3> order{};
+    Vec3 lo{}, len{}, inv_len{};  ///< global parameter box of the piece
+    int H = 3;                    ///< geometry coordinates: 3 polynomial, 4 rational (wx wy wz w)
+    int nc = 3;                   ///< coordinates per control point: H + properties (times w)
+    Kernels k;
+    std::size_t net = 0;  ///< offset into the pool
+    Vec3 lipschitz{};     ///< bounds on |dX/dt_d| (global parameters); inf if rational
+    StepBounds bounds;    ///< second-derivative bounds (polynomial pieces with all_first)
+  };
+  struct Cell {
+    std::array<std::vector<double>, 3> breaks;  ///< distinct knots inside the domain
+    std::array<int, 3> spans{};
+    int first_piece = 0;
+    Vec3 lo{}, hi{};
+  };
+  struct Node {
+    Vec3 lo{}, hi{};
+    int left = -1, right = -1;  ///< children, or -1 for a leaf node
+    int first = 0, count = 0;   ///< range of items for a leaf node
+  };
+
+  int m = 0;  ///< properties per point
+  std::vector<Cell> cells;
+  std::vector<Piece> pieces;
+  std::vector<double> pool;  ///< every piece's net, control point after control point
+  std::vector<LocatorLeaf> leaves;
+  std::vector<Node> nodes;
+  std::vector<int> items;  ///< leaf indices in BVH order
+
+  const Piece& piece_at(int cell, const Vec3& t) const noexcept {
+    const Cell& c = cells[static_cast<std::size_t>(cell)];
+    int idx[3];
+    for (int d = 0; d < 3; ++d) {
+      const auto& br = c.breaks[static_cast<std::size_t>(d)];
+      const int n = c.spans[static_cast<std::size_t>(d)];
+      if (n == 1) {
+        idx[d] = 0;
+        continue;
+      }
+      const auto it = std::upper_bound(br.begin() + 1, br.begin() + n, t[static_cast<std::size_t>(d)]);
+      idx[d] = static_cast<int>(it - br.begin()) - 1;
+    }
+    return pieces[static_cast<std::size_t>(c.first_piece + idx[0] + c.spans[0] * (idx[1] + c.spans[1] * idx[2]))];
+  }
+
+  static void local(const Piece& pc, const Vec3& t, double* s) noexcept {
+    for (std::size_t d = 0; d < 3; ++d) s[d] = std::clamp((t[d] - pc.lo[d]) * pc.inv_len[d], 0.0, 1.0);
+  }
+
+  /// X (3) and, with J, the Jacobian columns J[d] = dX/dt_d (global parameters) at t.
+  void eval_geom(const Piece& pc, const Vec3& t, double* X, double (*J)[3]) const noexcept {
+    double s[3], f[16];
+    local(pc, t, s);
+    (J ? pc.k.first : pc.k.value)(pool.data() + pc.net, pc.nc, pc.order, s, f);
+    if (pc.H == 3) {
+      for (int h = 0; h < 3; ++h) X[h] = f[h];
+      if (J)
+        for (std::size_t d = 0; d < 3; ++d)
+          for (std::size_t h = 0; h < 3; ++h) J[d][h] = f[3 * (d + 1) + h] * pc.inv_len[d];
+      return;
+    }
+    const double iw = 1.0 / f[3];
+    for (int h = 0; h < 3; ++h) X[h] = f[h] * iw;
+    if (J)
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double* fd = f + 4 * (d + 1);
+        for (std::size_t h = 0; h < 3; ++h) J[d][h] = (fd[h] - X[h] * fd[3]) * iw * pc.inv_len[d];
+      }
+  }
+
+  /// xyz (3) and the m properties of piece pc at t, in one pass over its net.
+  /// @param buf  pc.nc values of scratch
+  template <class T>
+  void eval_all(const Piece& pc, const Vec3& t, double* buf, double* X, T* props) const noexcept {
+    double s[3];
+    local(pc, t, s);
+    pc.k.all(pool.data() + pc.net, pc.nc, pc.order, s, buf);
+    const double iw = pc.H == 4 ? 1.0 / buf[3] : 1.0;
+    for (int h = 0; h < 3; ++h) X[h] = buf[h] * iw;
+    if (props)
+      for (int h = 0; h < m; ++h) props[h] = static_cast<T>(buf[pc.H + h] * iw);
+  }
+};
+
+/// Scratch for Data::eval_all: on the stack for up to 64 coordinates.
+class Scratch {
+public:
+  explicit Scratch(int n) {
+    if (n > 64) heap_.resize(static_cast<std::size_t>(n));
+  }
+  double* data() noexcept { return heap_.empty() ? stack_ : heap_.data(); }
+
+private:
+  double stack_[64];
+  std::vector<double> heap_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Construction.
+
+namespace {
+
+using Data = Locator::Data;
+
+struct CellBuild {
+  Data::Cell cell;
+  std::vector<Data::Piece> pieces;
+  std::vector<std::vector<double>> nets;
+  std::vector<LocatorLeaf> leaves;  // piece = local index until merged
+};
+
+/// Subdivides a piece's parameter box (local [0,1]^3) into nearly affine leaves: deviation from
+/// affine at most 10% of the leaf's diagonal and, when `max_dev` > 0, at most max_dev.
+void build_leaves(const std::vector<double>& net, const std::array<int, 3>& ord, int H, double min_diag, double max_dev,
+                  int max_leaves, std::vector<std::pair<std::array<Vec3, 2>, Flatness>>& out) {
+  constexpr double flat = 0.1;  // deviation / diagonal at which a leaf is flat enough
+  struct Item {
+    Vec3 lo, hi;
+    std::vector<double> net;
+    Flatness f;
+  };
+  // Most deviating first, so a leaf budget that runs out leaves the pieces evenly refined.
+  auto less = [](const Item& a, const Item& b) { return a.f.deviation < b.f.deviation; };
+  std::vector<Item> work;
+  work.push_back({{0, 0, 0}, {1, 1, 1}, net, flatness(net, ord, H)});
+  while (!work.empty()) {
+    std::pop_heap(work.begin(), work.end(), less);
+    Item it = std::move(work.back());
+    work.pop_back();
+    const bool flat_enough = it.f.deviation <= flat * it.f.diagonal && (max_dev <= 0.0 || it.f.deviation <= max_dev);
+    const bool done = flat_enough || it.f.diagonal < min_diag || static_cast<int>(out.size() + work.size()) + 2 > max_leaves;
+    if (done) {
+      out.push_back({{it.lo, it.hi}, it.f});
+      continue;
+    }
+    // Split the direction whose halves come out flattest (absolute deviation: splitting a
+    // direction along which the net is already straight leaves the deviation as it is).
+    int best = -1;
+    double best_dev = inf;
+    for (int d = 0; d < 3; ++d) {
+      if (ord[static_cast<std::size_t>(d)] < 2) continue;
+      double dev = 0.0;
+      for (int side = 0; side < 2; ++side) {
+        Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
+        (side ? lo : hi)[static_cast<std::size_t>(d)] = 0.5;
+        dev = std::max(dev, flatness(restrict_net(it.net, ord, H, lo, hi), ord, H).deviation);
+      }
+      if (dev < best_dev) {
+        best_dev = dev;
+        best = d;
+      }
+    }
+    if (best < 0) {
+      out.push_back({{it.lo, it.hi}, it.f});
+      continue;
+    }
+    for (int side = 0; side < 2; ++side) {
+      Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
+      (side ? lo : hi)[static_cast<std::size_t>(best)] = 0.5;
+      Item child;
+      child.net = restrict_net(it.net, ord, H, lo, hi);
+      child.f = flatness(child.net, ord, H);
+      child.lo = it.lo;
+      child.hi = it.hi;
+      const double mid = 0.5 * (it.lo[static_cast<std::size_t>(best)] + it.hi[static_cast<std::size_t>(best)]);
+      (side ? child.lo : child.hi)[static_cast<std::size_t>(best)] = mid;
+      work.push_back(std::move(child));
+      std::push_heap(work.begin(), work.end(), less);
+    }
+  }
+}
+
+/// Bounds on the second partials of a polynomial piece (net: nc = 3 + m coordinates per point):
+/// d^2/dt_d dt_e is a Bezier polynomial with control points (scaled) second differences of the
+/// net, so their largest norm bounds it (convex hull property).
+StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::Piece& pc, int m) {
+  StepBounds b;
+  b.valid = true;
+  for (std::size_t d = 0; d < 3; ++d) {
+    b.lo[d] = pc.lo[d];
+    b.hi[d] = pc.lo[d] + pc.len[d];
+  }
+  const auto& o = pc.order;
+  const int nc = pc.nc;
+  const int stride[3] = {1, o[0], o[0] * o[1]};
+  const int n = o[0] * o[1] * o[2];
+  for (int d = 0; d < 3; ++d)
+    for (int e = d; e < 3; ++e) {
+      const auto ud = static_cast<std::size_t>(d), ue = static_cast<std::size_t>(e);
+      const double factor = d == e ? (o[ud] - 1.0) * (o[ud] - 2.0) * pc.inv_len[ud] * pc.inv_len[ud]
+                                   : (o[ud] - 1.0) * (o[ue] - 1.0) * pc.inv_len[ud] * pc.inv_len[ue];
+      double bx = 0.0, bp = 0.0;
+      if (factor != 0.0)
+        for (int i = 0; i < n; ++i) {
+          const int idx[3] = {i % o[0], (i / o[0]) % o[1], i / (o[0] * o[1])};
+          // Corner offsets of the second difference: d == e: i, i+s, i+2s (1, -2, 1);
+          // d != e: i, i+sd, i+se, i+sd+se (1, -1, -1, 1).
+          int off[4];
+          double w[4];
+          int terms;
+          if (d == e) {
+            if (idx[d] + 2 >= o[ud]) continue;
+            off[0] = i, off[1] = i + stride[d], off[2] = i + 2 * stride[d];
+            w[0] = 1, w[1] = -2, w[2] = 1;
+            terms = 3;
+          } else {
+            if (idx[d] + 1 >= o[ud] || idx[e] + 1 >= o[ue]) continue;
+            off[0] = i, off[1] = i + stride[d], off[2] = i + stride[e], off[3] = i + stride[d] + stride[e];
+            w[0] = 1, w[1] = -1, w[2] = -1, w[3] = 1;
+            terms = 4;
+          }
+          double x2 = 0.0;
+          for (int h = 0; h < nc; ++h) {
+            double v = 0.0;
+            for (int k = 0; k < terms; ++k) v += w[k] * net[static_cast<std::size_t>(off[k] * nc + h)];
+            if (h < 3)
+              x2 += v * v;
+            else
+              bp = std::max(bp, std::abs(v));
+          }
+          bx = std::max(bx, std::sqrt(x2));
+        }
+      // Rounding in the differences is far below these bounds' slack; 1e-12 relative covers it.
+      b.b2[ud][ue] = b.b2[ue][ud] = bx * factor * (1.0 + 1e-12);
+      b.p2 = std::max(b.p2, bp * factor * (1.0 + 1e-12));
+    }
+  (void)m;
+  for (std::size_t d = 0; d < 3; ++d)
+    b.lip = std::max(b.lip, std::sqrt(b.b2[d][0] * b.b2[d][0] + b.b2[d][1] * b.b2[d][1] + b.b2[d][2] * b.b2[d][2]));
+  return b;
+}
+
+CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const LocatorOptions& opt) {
+  const auto& s = vc.volume;
+  CellBuild cb;
+  for (int d = 0; d < 3; ++d) {
+    const auto dd = static_cast<std::size_t>(d);
+    if (s.knots(d).order() > max_order)
+      throw Error("cell " + vc.name + ": order " + std::to_string(s.knots(d).order()) + " in direction " + "uvw"[d] +
+                  "; expected at most " + std::to_string(max_order) + " for point location");
+    for (const auto& br : s.knots(d).breakpoints()) cb.cell.breaks[dd].push_back(br.value);
+    cb.cell.spans[dd] = static_cast<int>(cb.cell.breaks[dd].size()) - 1;
+    cb.cell.lo[dd] = s.domain(d)[0];
+    cb.cell.hi[dd] = s.domain(d)[1];
+  }
+  const auto pieces = spline::bezier_pieces(s);
+  const int H = s.rational() ? 4 : 3;
+  const double min_diag = 100.0 * opt.tolerance;
+  for (std::size_t pi = 0; pi < pieces.size(); ++pi) {
+    const auto& bp = pieces[pi];
+    Data::Piece pc;
+    pc.cell = cell_index;
+    pc.order = bp.orders();
+    pc.H = H;
+    pc.nc = H + m;
+    pc.k = H == 3 ? pick_kernels<3>(pc.order, pc.nc) : pick_kernels<4>(pc.order, pc.nc);
+    for (int d = 0; d < 3; ++d) {
+      const auto dd = static_cast<std::size_t>(d);
+      pc.lo[dd] = bp.domain(d)[0];
+      pc.len[dd] = bp.domain(d)[1] - bp.domain(d)[0];
+      pc.inv_len[dd] = 1.0 / pc.len[dd];
+    }
+    const int n = bp.size();
+    std::vector<double> g(static_cast<std::size_t>(n * H)), all(static_cast<std::size_t>(n * pc.nc));
+    for (int i = 0; i < n; ++i) {
+      const auto q = bp.point(i);
+      const double w = H == 4 ? bp.weights()[static_cast<std::size_t>(i)] : 1.0;
+      for (int h = 0; h < 3; ++h) g[static_cast<std::size_t>(i * H + h)] = w * q[static_cast<std::size_t>(h)];
+      if (H == 4) g[static_cast<std::size_t>(i * H + 3)] = w;
+      for (int h = 0; h < H; ++h) all[static_cast<std::size_t>(i * pc.nc + h)] = g[static_cast<std::size_t>(i * H + h)];
+      for (int h = 0; h < m; ++h) all[static_cast<std::size_t>(i * pc.nc + H + h)] = w * q[static_cast<std::size_t>(3 + h)];
+    }
+    // Hodograph bound: |dX/dt_d| <= (order - 1) max |P_{i+1} - P_i| / len (polynomial only).
+    for (int d = 0; d < 3; ++d) {
+      const auto dd = static_cast<std::size_t>(d);
+      if (H == 4 || pc.order[dd] < 2) {
+        pc.lipschitz[dd] = H == 4 ? inf : 0.0;
+        continue;
+      }
+      const int step = d == 0 ? 1 : d == 1 ? pc.order[0] : pc.order[0] * pc.order[1];
+      double mx = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const int idx = d == 0 ? i % pc.order[0] : d == 1 ? (i / pc.order[0]) % pc.order[1] : i / (pc.order[0] * pc.order[1]);
+        if (idx + 1 >= pc.order[dd]) continue;
+        double diff[3];
+        for (int h = 0; h < 3; ++h) diff[h] = g[static_cast<std::size_t>((i + step) * H + h)] - g[static_cast<std::size_t>(i * H + h)];
+        mx = std::max(mx, norm3(diff));
+      }
+      pc.lipschitz[dd] = (pc.order[dd] - 1) * mx * pc.inv_len[dd];
+    }
+    if (pc.k.all_first) pc.bounds = second_derivative_bounds(all, pc, m);
+    std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
+    build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.max_leaves_per_piece, lv);
+    for (const auto& [box, fl] : lv) {
+      LocatorLeaf leaf;
+      leaf.cell = cell_index;
+      leaf.piece = static_cast<int>(pi);
+      for (int d = 0; d < 3; ++d) {
+        const auto dd = static_cast<std::size_t>(d);
+        // The piece's own end knots at the ends, so leaves tile the domain without gaps.
+        leaf.lo[dd] = box[0][dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + box[0][dd] * pc.len[dd];
+        leaf.hi[dd] = box[1][dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + box[1][dd] * pc.len[dd];
+      }
+      leaf.box_lo = fl.box_lo;
+      leaf.box_hi = fl.box_hi;
+      leaf.frame_origin = fl.origin;
+      leaf.frame = fl.frame;
+      leaf.frame_lo = fl.frame_lo;
+      leaf.frame_hi = fl.frame_hi;
+      for (std::size_t k = 0; k < 3; ++k)
+        leaf.frame_scale[k] = std::sqrt(fl.frame[k][0] * fl.frame[k][0] + fl.frame[k][1] * fl.frame[k][1] + fl.frame[k][2] * fl.frame[k][2]);
+      cb.leaves.push_back(leaf);
+    }
+    cb.pieces.push_back(pc);
+    cb.nets.push_back(std::move(all));
+  }
+  return cb;
+}
+
+/// Median-split BVH over the leaf boxes.
+void build_bvh(Data& D) {
+  const int n = static_cast<int>(D.leaves.size());
+  D.items.resize(static_cast<std::size_t>(n));
+  std::iota(D.items.begin(), D.items.end(), 0);
+  D.nodes.clear();
+  if (n == 0) return;
+  auto centre = [&](int i, int d) {
+    const auto& l = D.leaves[static_cast<std::size_t>(i)];
+    return l.box_lo[static_cast<std::size_t>(d)] + l.box_hi[static_cast<std::size_t>(d)];
+  };
+  struct Task {
+    int node, first, count;
+  };
+  D.nodes.push_back({});
+  std::vector<Task> stack{{0, 0, n}};
+  while (!stack.empty()) {
+    const Task t = stack.back();
+    stack.pop_back();
+    Data::Node nd;
+    nd.lo = {inf, inf, inf};
+    nd.hi = {-inf, -inf, -inf};
+    for (int k = t.first; k < t.first + t.count; ++k) {
+      const auto& l = D.leaves[static_cast<std::size_t>(D.items[static_cast<std::size_t>(k)])];
+      for (int d = 0; d < 3; ++d) {
+        nd.lo[static_cast<std::size_t>(d)] = std::min(nd.lo[static_cast<std::size_t>(d)], l.box_lo[static_cast<std::size_t>(d)]);
+        nd.hi[static_cast<std::size_t>(d)] = std::max(nd.hi[static_cast<std::size_t>(d)], l.box_hi[static_cast<std::size_t>(d)]);
+      }
+    }
+    if (t.count <= 4) {
+      nd.first = t.first;
+      nd.count = t.count;
+      D.nodes[static_cast<std::size_t>(t.node)] = nd;
+      continue;
+    }
+    int axis = 0;
+    for (int d = 1; d < 3; ++d)
+      if (nd.hi[static_cast<std::size_t>(d)] - nd.lo[static_cast<std::size_t>(d)] >
+          nd.hi[static_cast<std::size_t>(axis)] - nd.lo[static_cast<std::size_t>(axis)])
+        axis = d;
+    const int half = t.count / 2;
+    auto b = D.items.begin() + t.first;
+    std::nth_element(b, b + half, b + t.count, [&](int x, int y) {
+      const double cx = centre(x, axis), cy = centre(y, axis);
+      return cx < cy || (cx == cy && x < y);
+    });
+    nd.left = static_cast<int>(D.nodes.size());
+    nd.right = nd.left + 1;
+    D.nodes.push_back({});
+    D.nodes.push_back({});
+    D.nodes[static_cast<std::size_t>(t.node)] = nd;
+    stack.push_back({nd.left, t.first, half});
+    stack.push_back({nd.right, t.first + half, t.count - half});
+  }
+}
+
+}  // namespace
+
+Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&model), opt_(opt), data_(std::make_unique<Data>()) {
+  if (!(std::isfinite(opt.tolerance) && opt.tolerance > 0.0))
+    throw Error("locator tolerance " + std::to_string(opt.tolerance) + "; expected a positive finite length");
+  if (opt_.max_newton < 1) opt_.max_newton = 1;
+  Data& D = *data_;
+  D.m = static_cast<int>(model.properties.size());
+  const int nc = static_cast<int>(model.cells.size());
+  for (int c = 0; c < nc; ++c)
+    if (model.cells[static_cast<std::size_t>(c)].volume.dim() != model.dim())
+      throw Error("cell " + model.cells[static_cast<std::size_t>(c)].name + ": " +
+                  std::to_string(model.cells[static_cast<std::size_t>(c)].volume.dim()) +
+                  " coordinates per control point; expected " + std::to_string(model.dim()) + " (xyz and the model's properties)");
+  std::vector<CellBuild> built(static_cast<std::size_t>(nc));
+  tbb::parallel_for(0, nc, [&](int c) {
+    built[static_cast<std::size_t>(c)] = build_cell(model.cells[static_cast<std::size_t>(c)], c, D.m, opt_);
+  });
+  std::size_t size = 0;
+  for (auto& cb : built)
+    for (const auto& net : cb.nets) size += net.size();
+  D.pool.reserve(size);
+  for (auto& cb : built) {
+    cb.cell.first_piece = static_cast<int>(D.pieces.size());
+    for (auto& leaf : cb.leaves) {
+      leaf.piece += cb.cell.first_piece;
+      D.leaves.push_back(leaf);
+    }
+    for (std::size_t i = 0; i < cb.pieces.size(); ++i) {
+      auto pc = cb.pieces[i];
+      pc.net = D.pool.size();
+      D.pool.insert(D.pool.end(), cb.nets[i].begin(), cb.nets[i].end());
+      D.pieces.push_back(pc);
+    }
+    D.cells.push_back(std::move(cb.cell));
+  }
+  build_bvh(D);
+}
+
+Locator::~Locator() = default;
+Locator::Locator(Locator&&) noexcept = default;
+Locator& Locator::operator=(Locator&&) noexcept = default;
+
+const vmodel::VModel& Locator::model() const noexcept { return *model_; }
+const LocatorOptions& Locator::options() const noexcept { return opt_; }
+std::span<const LocatorLeaf> Locator::leaves() const noexcept { return data_->leaves; }
+
+std::array<Vec3, 2> Locator::domain(int cell) const noexcept {
+  const auto& c = data_->cells[static_cast<std::size_t>(cell)];
+  return {c.lo, c.hi};
+}
+
+void Locator::query(const Vec3& lo, const Vec3& hi, double pad, std::vector<int>& out) const {
+  out.clear();
+  const Data& D = *data_;
+  if (D.nodes.empty()) return;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  auto overlaps = [&](const Vec3& blo, const Vec3& bhi) {
+    for (int d = 0; d < 3; ++d)
+      if (bhi[static_cast<std::size_t>(d)] + pad < lo[static_cast<std::size_t>(d)] ||
+          blo[static_cast<std::size_t>(d)] - pad > hi[static_cast<std::size_t>(d)])
+        return false;
+    return true;
+  };
+  while (top > 0) {
+    const auto& nd = D.nodes[static_cast<std::size_t>(stack[--top])];
+    if (!overlaps(nd.lo, nd.hi)) continue;
+    if (nd.left < 0) {
+      for (int k = nd.first; k < nd.first + nd.count; ++k) {
+        const int li = D.items[static_cast<std::size_t>(k)];
+        const auto& l = D.leaves[static_cast<std::size_t>(li)];
+        if (overlaps(l.box_lo, l.box_hi)) out.push_back(li);
+      }
+      continue;
+    }
+    stack[top++] = nd.left;
+    stack[top++] = nd.right;
+  }
+  std::sort(out.begin(), out.end());
+}
+
+void Locator::eval(int cell, const Vec3& uvw, double* xyz, double* props) const {
+  const auto& pc = data_->piece_at(cell, uvw);
+  Scratch buf(pc.nc);
+  data_->eval_all(pc, uvw, buf.data(), xyz, props);
+}
+
+void Locator::eval_properties(int cell, const Vec3& uvw, float* props) const {
+  const auto& pc = data_->piece_at(cell, uvw);
+  Scratch buf(pc.nc);
+  double x[3];
+  data_->eval_all(pc, uvw, buf.data(), x, props);
+}
+
+bool Locator::check(int cell, const Vec3& p, const Vec3& uvw, float* props, Vec3* residual) const {
+  const Data& D = *data_;
+  const auto& pc = D.piece_at(cell, uvw);
+  double x[3];
+  if (pc.nc <= 64) {
+    double buf[64];
+    D.eval_all(pc, uvw, buf, x, props);
+  } else {
+    std::vector<double> buf(static_cast<std::size_t>(pc.nc));
+    D.eval_all(pc, uvw, buf.data(), x, props);
+  }
+  const Vec3 r{p[0] - x[0], p[1] - x[1], p[2] - x[2]};
+  if (residual) *residual = r;
+  return r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < opt_.tolerance * opt_.tolerance;
+}
+
+bool Locator::expand(int cell, const Vec3& t, Expansion& out) const {
+  const Data& D = *data_;
+  const auto& pc = D.piece_at(cell, t);
+  if (!pc.k.all_first || D.m > Expansion::max_props) return false;
+  const auto dom = domain(cell);
+  Vec3 tc;
+  for (std::size_t d = 0; d < 3; ++d) tc[d] = std::clamp(t[d], dom[0][d], dom[1][d]);
+  double s[3], f[4 * 10];
+  Data::local(pc, tc, s);
+  pc.k.all_first(D.pool.data() + pc.net, pc.nc, pc.order, s, f);
+  const int nc = pc.nc;
+  out.piece = static_cast<int>(&pc - D.pieces.data());
+  out.t = tc;
+  for (std::size_t h = 0; h < 3; ++h) {
+    out.x[h] = f[h];
+    for (std::size_t d = 0; d < 3; ++d) out.jac[d][h] = f[static_cast<std::size_t>(nc) * (d + 1) + h] * pc.inv_len[d];
+  }
+  for (int h = 0; h < D.m; ++h) {
+    const auto uh = static_cast<std::size_t>(h);
+    out.props[uh] = f[3 + uh];
+    for (std::size_t d = 0; d < 3; ++d) out.grad[uh][d] = f[static_cast<std::size_t>(nc) * (d + 1) + 3 + uh] * pc.inv_len[d];
+  }
+  return true;
+}
+
+const StepBounds& Locator::step_bounds(int piece) const noexcept { return data_->pieces[static_cast<std::size_t>(piece)].bounds; }
+
+namespace {
+/// A converged answer, with one more Newton step (not evaluated) as the warm start for neighbours:
+/// the answer itself is only within the tolerance, and extrapolating from such answers would
+/// amplify that error; the extra step brings it to about the square of the residual.
+NewtonResult converged(const Vec3& t, const double J[3][3], const double* r, double rn, const Vec3& lo, const Vec3& hi) {
+  NewtonResult res{NewtonStatus::converged, t, rn, t, {}};
+  for (std::size_t d = 0; d < 3; ++d) res.jacobian[d] = {J[d][0], J[d][1], J[d][2]};
+  double step[3];
+  solve3(J, r, step);
+  for (std::size_t d = 0; d < 3; ++d) res.polished[d] = std::clamp(t[d] + step[d], lo[d], hi[d]);
+  return res;
+}
+}  // namespace
+
+NewtonResult Locator::newton(int cell, const Vec3& p, const Vec3& start, const Vec3& lo, const Vec3& hi, int max_iter) const {
+  const Data& D = *data_;
+  const double tol = opt_.tolerance;
+  if (max_iter <= 0) max_iter = opt_.max_newton;
+  Vec3 t;
+  for (int d = 0; d < 3; ++d) t[static_cast<std::size_t>(d)] = std::clamp(start[static_cast<std::size_t>(d)], lo[static_cast<std::size_t>(d)], hi[static_cast<std::size_t>(d)]);
+  double X[3], J[3][3], r[3];
+  D.eval_geom(D.piece_at(cell, t), t, X, J);
+  for (int h = 0; h < 3; ++h) r[h] = p[static_cast<std::size_t>(h)] - X[h];
+  double rn = norm3(r);
+  NewtonResult res;
+  for (int it = 0; it < max_iter; ++it) {
+    if (rn < tol) return converged(t, J, r, rn, lo, hi);
+    if (!std::isfinite(rn)) break;
+    // Projected Newton: freeze coordinates at a bound whose step points outwards.
+    double step[3];
+    bool free[3] = {true, true, true};
+    solve3(J, r, step);
+    bool pinned = false;
+    for (int pass = 0; pass < 3; ++pass) {
+      bool changed = false;
+      for (int d = 0; d < 3; ++d) {
+        const auto dd = static_cast<std::size_t>(d);
+        if (free[d] && ((t[dd] <= lo[dd] && step[d] < 0.0) || (t[dd] >= hi[dd] && step[d] > 0.0))) {
+          free[d] = false;
+          changed = pinned = true;
+        }
+      }
+      if (!changed) break;
+      solve_free(J, r, free, step);
+    }
+    if (pinned) {
+      double pred[3];
+      for (int h = 0; h < 3; ++h) pred[h] = J[0][h] * step[0] + J[1][h] * step[1] + J[2][h] * step[2];
+      double rest[3] = {r[0] - pred[0], r[1] - pred[1], r[2] - pred[2]};
+      const double e = norm3(rest), moved = norm3(pred);
+      // Stationary on the box boundary, pulled outwards, and the first-order residual is real.
+      if (e > tol && moved <= std::max(0.5 * tol, 0.05 * e)) return {NewtonStatus::outside, t, rn, t, {}};
+    }
+    // Damped step: halve until the residual decreases.
+    double lambda = 1.0;
+    bool accepted = false;
+    for (int ls = 0; ls < 8; ++ls, lambda *= 0.5) {
+      Vec3 tn;
+      for (int d = 0; d < 3; ++d)
+        tn[static_cast<std::size_t>(d)] = std::clamp(t[static_cast<std::size_t>(d)] + lambda * step[d], lo[static_cast<std::size_t>(d)], hi[static_cast<std::size_t>(d)]);
+      double Xn[3], Jn[3][3], rnv[3];
+      D.eval_geom(D.piece_at(cell, tn), tn, Xn, Jn);
+      for (int h = 0; h < 3; ++h) rnv[h] = p[static_cast<std::size_t>(h)] - Xn[h];
+      const double rnn = norm3(rnv);
+      if (rnn < rn || rnn < tol) {
+        t = tn;
+        std::copy(rnv, rnv + 3, r);
+        std::copy(&Jn[0][0], &Jn[0][0] + 9, &J[0][0]);
+        rn = rnn;
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      // No descent along the Newton direction: stuck. Pinned on the boundary means outside.
+      if (pinned && rn > tol) return {NewtonStatus::outside, t, rn, t, {}};
+      break;
+    }
+  }
+  if (rn < tol) return converged(t, J, r, rn, lo, hi);
+  return {NewtonStatus::failed, t, rn, t, {}};
+}
+
+namespace {
+/// Newton in every 1/3 x 1/3 x 1/3 part of [lo, hi]; recursion `depth` levels deep on parts that fail.
+NewtonResult subdivide(const Locator& L, const Data& D, int cell, const Vec3& p, const Vec3& lo, const Vec3& hi, int depth) {
+  NewtonResult best;
+  best.residual = inf;
+  bool failed = false;
+  const double tol = L.options().tolerance;
+  for (int k = 0; k < 27; ++k) {
+    const int idx[3] = {k % 3, (k / 3) % 3, k / 9};
+    Vec3 a, b, c;
+    for (int d = 0; d < 3; ++d) {
+      const auto dd = static_cast<std::size_t>(d);
+      const double w = (hi[dd] - lo[dd]) / 3.0;
+      a[dd] = lo[dd] + idx[d] * w;
+      b[dd] = idx[d] == 2 ? hi[dd] : lo[dd] + (idx[d] + 1) * w;
+      c[dd] = 0.5 * (a[dd] + b[dd]);
+    }
+    // Skip parts whose image provably misses p (hodograph bound; polynomial pieces).
+    const auto& pc = D.piece_at(cell, c);
+    double X[3];
+    D.eval_geom(pc, c, X, nullptr);
+    const double dist = std::sqrt((X[0] - p[0]) * (X[0] - p[0]) + (X[1] - p[1]) * (X[1] - p[1]) + (X[2] - p[2]) * (X[2] - p[2]));
+    double reach = tol;
+    for (int d = 0; d < 3; ++d) reach += pc.lipschitz[static_cast<std::size_t>(d)] * 0.5 * (b[static_cast<std::size_t>(d)] - a[static_cast<std::size_t>(d)]);
+    if (dist > reach) continue;
+    NewtonResult r = L.newton(cell, p, c, a, b);
+    if (r.status == NewtonStatus::failed && depth > 1) r = subdivide(L, D, cell, p, a, b, depth - 1);
+    if (r.status == NewtonStatus::converged) return r;
+    if (r.status == NewtonStatus::failed) failed = true;
+    if (r.residual < best.residual) best = r;
+  }
+  best.status = failed ? NewtonStatus::failed : NewtonStatus::outside;
+  if (!std::isfinite(best.residual)) best.uvw = {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+  return best;
+}
+}  // namespace
+
+NewtonResult Locator::solve_in_leaf(int leaf, const Vec3& p, const Vec3* start) const {
+  const auto& l = data_->leaves[static_cast<std::size_t>(leaf)];
+  const Vec3 c = {0.5 * (l.lo[0] + l.hi[0]), 0.5 * (l.lo[1] + l.hi[1]), 0.5 * (l.lo[2] + l.hi[2])};
+  NewtonResult r = newton(l.cell, p, start ? *start : c, l.lo, l.hi);
+  if (r.status != NewtonStatus::failed) return r;
+  if (start) {  // a warm start may have led astray: try the centre before subdividing
+    r = newton(l.cell, p, c, l.lo, l.hi);
+    if (r.status != NewtonStatus::failed) return r;
+  }
+  NewtonResult s = subdivide(*this, *data_, l.cell, p, l.lo, l.hi, 1);
+  return s;
+}
+
+LocateResult Locator::locate(const Vec3& p, const LocateResult* hint) const {
+  std::vector<int> cand;
+  query(p, p, opt_.tolerance, cand);
+  LocateResult out;
+  const double guess = 500.0 * opt_.tolerance;
+  std::size_t k = 0;
+  while (k < cand.size()) {
+    const int cell = data_->leaves[static_cast<std::size_t>(cand[k])].cell;
+    std::size_t e = k;
+    while (e < cand.size() && data_->leaves[static_cast<std::size_t>(cand[e])].cell == cell) ++e;
+    if (hint && hint->inside && hint->cell == cell) {
+      const auto dom = domain(cell);
+      const auto r = newton(cell, p, hint->uvw, dom[0], dom[1]);
+      if (r.status == NewtonStatus::converged) return {true, cell, r.uvw, out.converged};
+    }
+    NewtonResult best;
+    best.residual = inf;
+    bool failed = false;
+    for (std::size_t i = k; i < e; ++i) {
+      if (!data_->leaves[static_cast<std::size_t>(cand[i])].may_contain(p, opt_.tolerance)) continue;
+      const auto r = solve_in_leaf(cand[i], p);
+      if (r.status == NewtonStatus::converged) return {true, cell, r.uvw, out.converged};
+      if (r.status == NewtonStatus::failed) {
+        failed = true;
+        if (r.residual < best.residual) best = r;
+      }
+    }
+    if (failed) {
+      out.converged = false;
+      if (best.residual < guess) return {true, cell, best.uvw, false};
+    }
+    k = e;
+  }
+  return out;
+}
+
+std::array<Vec3, 2> model_bounds(const vmodel::VModel& model) {
+  if (model.cells.empty()) throw Error("the model has no cells; expected at least one volumetric cell to slice");
+  std::array<Vec3, 2> b{Vec3{inf, inf, inf}, Vec3{-inf, -inf, -inf}};
+  for (const auto& c : model.cells) {
+    const auto bb = spline::bounding_box(c.volume, 3);
+    for (std::size_t d = 0; d < 3; ++d) {
+      b[0][d] = std::min(b[0][d], bb[0][d]);
+      b[1][d] = std::max(b[1][d], bb[1][d]);
+    }
+  }
+  return b;
+}
+
+}  // namespace trivox::slice

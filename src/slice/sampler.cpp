@@ -1,0 +1,619 @@
+#include "trivox/slice/sampler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "trivox/error.hpp"
+
+#include <atomic>
+#include <atomic>
+namespace trivox::slice {
+std::atomic<long> c_anchors, c_block, c_row, c_K, c_K1, c_fail, c_slow, c_expand;
+
+namespace {
+
+constexpr double sqrt3 = 1.7320508075688772;
+/// Property error the stepping certifies: the contract's 1/512 less 5% for rounding (the float
+/// stored is within 1e-7 of the double computed).
+constexpr double prop_budget = 0.95 / 512.0;
+
+LocatorOptions options_for(const VoxelGrid& grid) {
+  const double pmin = std::min({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
+  if (!(std::isfinite(pmin) && pmin > 0.0))
+    throw Error("voxel pitch " + std::to_string(pmin) + " mm; expected positive finite pitches");
+  LocatorOptions o;
+  o.tolerance = 1e-3 * pmin;
+  // Leaves hugging the cells to within two voxels: little empty space left to invert.
+  o.leaf_deviation = 2.0 * std::max({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
+  return o;
+}
+
+/// First voxel index whose centre is >= x (clamped to [0, n]).
+int first_at_or_after(double x, double origin, double pitch, int n) {
+  const double f = std::ceil((x - origin) / pitch - 0.5);
+  return static_cast<int>(std::clamp(f, 0.0, static_cast<double>(n)));
+}
+/// Last voxel index whose centre is <= x (clamped to [-1, n - 1]).
+int last_at_or_before(double x, double origin, double pitch, int n) {
+  const double f = std::floor((x - origin) / pitch - 0.5);
+  return static_cast<int>(std::clamp(f, -1.0, static_cast<double>(n - 1)));
+}
+
+/// The inverse of J (given by columns), as rows; false when singular.
+bool invert(const std::array<Vec3, 3>& J, std::array<Vec3, 3>& inv) {
+  auto cross = [](const Vec3& a, const Vec3& b) {
+    return Vec3{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+  };
+  const Vec3 c0 = cross(J[1], J[2]), c1 = cross(J[2], J[0]), c2 = cross(J[0], J[1]);
+  const double det = J[0][0] * c0[0] + J[0][1] * c0[1] + J[0][2] * c0[2];
+  if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return false;
+  for (std::size_t k = 0; k < 3; ++k) {
+    inv[0][k] = c0[k] / det;
+    inv[1][k] = c1[k] / det;
+    inv[2][k] = c2[k] / det;
+  }
+  return true;
+}
+
+inline Vec3 mul(const std::array<Vec3, 3>& rows, const Vec3& v) {
+  return {rows[0][0] * v[0] + rows[0][1] * v[1] + rows[0][2] * v[2], rows[1][0] * v[0] + rows[1][1] * v[1] + rows[1][2] * v[2],
+          rows[2][0] * v[0] + rows[2][1] * v[1] + rows[2][2] * v[2]};
+}
+
+/// A leaf met by the current row: its voxel interval and warm-start state.
+struct RowLeaf {
+  int leaf, cell;
+  int i0, i1;   ///< voxels whose centres lie in the leaf's regions (grown by the tolerance)
+  int last_i;   ///< the voxel this leaf last solved, or -2
+  Vec3 last_t;  ///< where that Newton run ended
+};
+
+/// Rows of a layer processed together: anchors certify rectangles of voxels spanning them.
+/// Blocks are aligned on multiples of this in image rows, and a band always computes whole
+/// blocks, so results never depend on the banding.
+constexpr int block_rows = 4;
+
+/// Certified first-order stepping from an anchor (an Expansion at voxel (ia, la) of a block):
+/// voxel (ia + k, la + l) gets t = t0 + J0^-1 (p - X0) = t0 + c0 + k dx + l dy and properties
+/// P0 + G0 (t - t0), accepted only when rigorous bounds show (Kantorovich) that the exact
+/// preimage t* of its centre lies within r of t inside the anchor's piece and that the
+/// properties are within 0.95/512 of P(t*). The bounds use the piece's second-derivative bounds
+/// (StepBounds): with d = t - t0, the Taylor remainder |X(t) - p| <= e = 1/2 sum b2_de |d_d| |d_e|;
+/// |J(t)^-1| <= beta0 / (1 - beta0 lip |d|_1) <= 2 beta0 while beta0 lip |d|_1 < 1/2; then a root
+/// lies within r = 2 (2 beta0) e when (2 beta0)^2 sqrt3 lip e <= 1/2. Bounding |d_j| by |c0_j| +
+/// |k| |dx_j| + |l| |dy_j| makes every bound grow with |k| and |l|, and the margin to the piece's
+/// box is affine in (k, l), so certifying the extreme |k|, |l| and the four corners certifies a
+/// whole rectangle: found once per anchor by doubling and bisection, after which a voxel costs a
+/// few multiply-adds.
+struct Anchor {
+  int ia = 0, la = 0;                 ///< voxel column and block row of the expansion
+  std::array<int, block_rows> lo{}, hi{};  ///< certified columns per block row (lo > hi: none)
+  Vec3 tb{}, dx{}, dy{};              ///< t(k, l) = tb + k dx + l dy
+  std::array<double, Expansion::max_props> pb{}, pdx{}, pdy{};  ///< P(k, l) likewise
+
+  bool covers(int l, int i) const { return lo[static_cast<std::size_t>(l)] <= i && i <= hi[static_cast<std::size_t>(l)]; }
+  Vec3 at(int l, int i) const {
+    const double k = i - ia, dl = l - la;
+    return {tb[0] + k * dx[0] + dl * dy[0], tb[1] + k * dx[1] + dl * dy[1], tb[2] + k * dx[2] + dl * dy[2]};
+  }
+};
+
+/// Builds anchors from expansions: the certification of the struct comment above.
+class AnchorMaker {
+public:
+  AnchorMaker(const Locator& loc, const VoxelGrid& grid, int m, int rows, double max_residual)
+      : loc_(loc), m_(m), rows_(rows), px_(grid.pitch[0]), py_(grid.pitch[1]), max_residual_(max_residual), nx_(grid.count[0]) {}
+
+  /// An anchor at voxel (i, l) with centre p from the expansion e; false when nothing (not even
+  /// the voxel itself) is certified.
+  bool make(const Expansion& e, int i, int l, const Vec3& p, Anchor& a) {
+    std::array<Vec3, 3> inv;
+    b_ = &loc_.step_bounds(e.piece);
+    if (!b_->valid || !invert(e.jac, inv)) return false;
+    e_ = &e;
+    c0_ = mul(inv, {p[0] - e.x[0], p[1] - e.x[1], p[2] - e.x[2]});
+    a.ia = i;
+    a.la = l;
+    a.dx = {inv[0][0] * px_, inv[1][0] * px_, inv[2][0] * px_};
+    a.dy = {-inv[0][1] * py_, -inv[1][1] * py_, -inv[2][1] * py_};  // the next image row is py lower
+    dx_ = a.dx;
+    dy_ = a.dy;
+    double f2 = 0.0;
+    for (const auto& row : inv) f2 += row[0] * row[0] + row[1] * row[1] + row[2] * row[2];
+    beta0_ = std::sqrt(f2);
+    gmax_ = 0.0;
+    for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h)
+      gmax_ = std::max({gmax_, std::abs(e.grad[h][0]), std::abs(e.grad[h][1]), std::abs(e.grad[h][2])});
+    for (std::size_t j = 0; j < 3; ++j) a.tb[j] = e.t[j] + c0_[j];
+    for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h) {
+      a.pb[h] = e.props[h] + e.grad[h][0] * c0_[0] + e.grad[h][1] * c0_[1] + e.grad[h][2] * c0_[2];
+      a.pdx[h] = e.grad[h][0] * a.dx[0] + e.grad[h][1] * a.dx[1] + e.grad[h][2] * a.dx[2];
+      a.pdy[h] = e.grad[h][0] * a.dy[0] + e.grad[h][1] * a.dy[1] + e.grad[h][2] * a.dy[2];
+    }
+    a.lo.fill(1);
+    a.hi.fill(0);
+    // Candidate rectangles: rows l - up .. l + down with columns i - K .. i + K (the largest K),
+    // for the whole block, the rows next to l, and l alone with columns i .. i + K; the one
+    // covering most voxels wins.
+    int best_up = 0, best_down = 0, best_k = -1, best_kn = 0;
+    long best_area = 0;
+    auto consider = [&](int up, int down, bool both_ways, int& guess) {
+      const int K = largest([&](int k) { return certified(both_ways ? k : 0, k, up, down); }, guess);
+      if (K < 0) return;
+      guess = K;
+      const long area = static_cast<long>(both_ways ? 2 * K + 1 : K + 1) * (up + down + 1);
+      if (area > best_area) {
+        best_area = area;
+        best_up = up, best_down = down, best_k = K, best_kn = both_ways ? K : 0;
+      }
+    };
+    consider(l, rows_ - 1 - l, true, guess_[0]);
+    if (rows_ > 2) consider(std::min(l, 1), std::min(rows_ - 1 - l, 1), true, guess_[1]);
+    consider(0, 0, false, guess_[2]);
+    c_anchors++; if (best_up + best_down > 0) c_block++; else c_row++; c_K += best_k; c_K1 += best_up + best_down + 1;
+    if (best_k < 0) return false;
+    for (int r = l - best_up; r <= l + best_down; ++r) {
+      a.lo[static_cast<std::size_t>(r)] = std::max(0, i - best_kn);
+      a.hi[static_cast<std::size_t>(r)] = std::min(nx_ - 1, i + best_k);
+    }
+    return true;
+  }
+
+private:
+  /// The largest k in [0, nx] with ok(k) (ok is monotone: true up to some k), or -1; tries a
+  /// little more than `guess` first (neighbouring anchors are alike).
+  template <class F>
+  int largest(F&& ok, int guess) const {
+    const int limit = nx_;
+    if (guess > 0) {
+      const int more = std::min(limit, guess + guess / 4 + 1);
+      if (ok(more)) return more;
+      if (ok(guess)) return guess;
+    }
+    if (!ok(0)) return -1;
+    int good = 0, bad = -1;
+    for (int k = 1; k <= limit; k *= 2) {
+      if (!ok(k)) {
+        bad = k;
+        break;
+      }
+      good = k;
+    }
+    if (bad < 0) {
+      if (ok(limit)) return limit;
+      bad = limit + 1;
+    }
+    while (bad - good > 1) {
+      const int mid = good + (bad - good) / 2;
+      (ok(mid) ? good : bad) = mid;
+    }
+    return good;
+  }
+
+  /// Whether every voxel (ia + k, la + l), -kn <= k <= kp, -ln <= l <= lp, is certified.
+  bool certified(int kn, int kp, int ln, int lp) const {
+    const double K = std::max(kn, kp), L = std::max(ln, lp);
+    const Vec3 a{std::abs(c0_[0]) + K * std::abs(dx_[0]) + L * std::abs(dy_[0]),
+                 std::abs(c0_[1]) + K * std::abs(dx_[1]) + L * std::abs(dy_[1]),
+                 std::abs(c0_[2]) + K * std::abs(dx_[2]) + L * std::abs(dy_[2])};
+    const double s1 = a[0] + a[1] + a[2];
+    if (!(beta0_ * b_->lip * s1 < 0.5)) return false;
+    const auto& B = b_->b2;
+    const double e2 = 0.5 * (B[0][0] * a[0] * a[0] + B[1][1] * a[1] * a[1] + B[2][2] * a[2] * a[2]) +
+                      B[0][1] * a[0] * a[1] + B[0][2] * a[0] * a[2] + B[1][2] * a[1] * a[2];
+    if (!(e2 <= max_residual_)) return false;
+    const double beta = 2.0 * beta0_;
+    const double eta = beta * e2;
+    if (!(beta * sqrt3 * b_->lip * eta <= 0.5)) return false;
+    const double r = 2.0 * eta;
+    for (std::size_t j = 0; j < 3; ++j) {
+      const double base = e_->t[j] + c0_[j];
+      const double c[4] = {base - kn * dx_[j] - ln * dy_[j], base + kp * dx_[j] - ln * dy_[j], base - kn * dx_[j] + lp * dy_[j],
+                           base + kp * dx_[j] + lp * dy_[j]};
+      const double lo = std::min({c[0], c[1], c[2], c[3]}), hi = std::max({c[0], c[1], c[2], c[3]});
+      if (!(lo - r >= b_->lo[j] && hi + r <= b_->hi[j])) return false;
+    }
+    const double perr = 0.5 * b_->p2 * s1 * s1 + (gmax_ + b_->p2 * (s1 + sqrt3 * r)) * sqrt3 * r;
+    return perr <= prop_budget;
+  }
+
+  const Locator& loc_;
+  int m_, rows_;
+  double px_, py_, max_residual_;
+  int nx_;
+  const StepBounds* b_ = nullptr;
+  const Expansion* e_ = nullptr;
+  Vec3 c0_{}, dx_{}, dy_{};
+  double beta0_ = 0.0, gmax_ = 0.0;
+  std::array<int, 3> guess_{-1, -1, -1};
+};
+
+/// The last converged voxels of a run in one cell, for extrapolating the next voxel's (u,v,w)
+/// where stepping does not apply (rational cells, many properties): their uvw corrected to well
+/// below the tolerance (extrapolation amplifies errors), and the inverse Jacobian of the last
+/// Newton run for those corrections.
+struct Chain {
+  Vec3 uvw[3] = {};
+  int n = 0;
+  std::array<Vec3, 3> inv{};
+  bool have_inv = false;
+
+  /// Quadratic (linear, constant) extrapolation; false when it leaves the domain.
+  bool predict(const std::array<Vec3, 2>& dom, Vec3& t) const {
+    for (std::size_t d = 0; d < 3; ++d) {
+      t[d] = n == 1 ? uvw[0][d] : n == 2 ? 2.0 * uvw[0][d] - uvw[1][d] : 3.0 * uvw[0][d] - 3.0 * uvw[1][d] + uvw[2][d];
+      if (t[d] < dom[0][d] || t[d] > dom[1][d]) return false;
+    }
+    return true;
+  }
+  void push(const Vec3& t) {
+    uvw[2] = uvw[1];
+    uvw[1] = uvw[0];
+    uvw[0] = t;
+    n = std::min(n + 1, 3);
+  }
+  /// A voxel accepted at t with residual r = p - X(t): a quasi-Newton step with the last
+  /// Jacobian (a few voxels away, so close) before remembering it.
+  void push_checked(Vec3 t, const Vec3& r, const std::array<Vec3, 2>& dom) {
+    if (have_inv) {
+      const Vec3 c = mul(inv, r);
+      for (std::size_t d = 0; d < 3; ++d) t[d] = std::clamp(t[d] + c[d], dom[0][d], dom[1][d]);
+    }
+    push(t);
+  }
+  void push_solved(const NewtonResult& res) {
+    have_inv = invert(res.jacobian, inv);
+    push(res.polished);
+  }
+};
+
+enum class Outcome { inside, guessed, outside };
+
+/// The slow path for one voxel: Newton over the cell from a prediction (when there is one), then
+/// the leaves whose intervals hold the voxel, each warm-started from its own answer at the
+/// previous voxel (Locator::solve_in_leaf, with its subdivision fallback).
+Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, const Vec3& p, const Vec3* start, Chain& chain,
+                    Vec3& t, RowLeaf* leaves_begin, RowLeaf* leaves_end, const std::array<Vec3, 2>& dom, std::int64_t& failures) {
+  NewtonResult res;
+  if (start) res = loc.newton(cell, p, *start, dom[0], dom[1], 6);
+  if (!start || res.status != NewtonStatus::converged) {
+    const Vec3 from = res.uvw;
+    NewtonResult best;
+    best.residual = std::numeric_limits<double>::infinity();
+    bool failed = false, found = false;
+    for (RowLeaf* rl = leaves_begin; rl != leaves_end; ++rl) {
+      if (i < rl->i0 || i > rl->i1) continue;
+      const Vec3* warm = rl->last_i == i - 1 ? &rl->last_t : start ? &from : nullptr;
+      const NewtonResult lr = loc.solve_in_leaf(rl->leaf, p, warm);
+      rl->last_i = i;
+      rl->last_t = lr.polished;
+      if (lr.status == NewtonStatus::converged) {
+        res = lr;
+        found = true;
+        break;
+      }
+      if (lr.status == NewtonStatus::failed) {
+        failed = true;
+        if (lr.residual < best.residual) best = lr;
+      }
+    }
+    if (!found) {
+      chain.n = 0;
+      if (!failed) return Outcome::outside;
+      ++failures;
+      // Best guess: inside when the best iterate's image is within half the smallest pitch.
+      const double guess = 0.5 * std::min({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
+      if (!(best.residual < guess)) return Outcome::outside;
+      t = best.uvw;
+      return Outcome::guessed;
+    }
+  }
+  t = res.uvw;
+  chain.push_solved(res);
+  return Outcome::inside;
+}
+
+/// Where a block's results go: rows of nx voxels, straight into the caller's band when the block
+/// lies inside it, else into scratch.
+struct BlockOut {
+  std::int32_t* owner = nullptr;  ///< rows x nx
+  float* props = nullptr;         ///< rows x nx x m
+  double* uvw = nullptr;          ///< rows x nx x 3, or null
+  std::array<std::int64_t, block_rows> failures{}, inverted{};
+};
+
+/// Samples image rows [r0, r0 + nr) of layer `layer` (one block) into `out`.
+class BlockSampler {
+public:
+  BlockSampler(const Locator& loc, const VoxelGrid& grid) : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())) {}
+
+  void run(int layer, int r0, int nr, BlockOut& out) {
+    const int nx = grid_.count[0], ny = grid_.count[1];
+    const auto unx = static_cast<std::size_t>(nx), um = static_cast<std::size_t>(m_);
+    std::fill_n(out.owner, static_cast<std::size_t>(nr) * unx, -1);
+    std::fill_n(out.props, static_cast<std::size_t>(nr) * unx * um, 0.0f);
+    if (out.uvw) std::fill_n(out.uvw, static_cast<std::size_t>(nr) * unx * 3, 0.0);
+    out.failures.fill(0);
+    out.inverted.fill(0);
+    out_ = &out;
+    tol_ = loc_.options().tolerance;
+    z_ = grid_.origin[2] + (layer + 0.5) * grid_.pitch[2];
+    for (int l = 0; l < nr; ++l) y_[static_cast<std::size_t>(l)] = grid_.origin[1] + (ny - 1 - (r0 + l) + 0.5) * grid_.pitch[1];
+    const double inf = std::numeric_limits<double>::infinity();
+
+    // Leaves meeting the block (in leaf order = cell order), and each row's voxel intervals.
+    cand_.clear();
+    loc_.for_each_leaf_in_box({-inf, y_[static_cast<std::size_t>(nr - 1)], z_}, {inf, y_[0], z_}, tol_,
+                              [&](int l) { cand_.push_back(l); });
+    if (cand_.empty()) return;
+    const auto leaves = loc_.leaves();
+    for (int l = 0; l < nr; ++l) {
+      auto& act = act_[static_cast<std::size_t>(l)];
+      act.clear();
+      for (int c : cand_) {
+        const auto& lf = leaves[static_cast<std::size_t>(c)];
+        double x0, x1;
+        if (!lf.row_range(y_[static_cast<std::size_t>(l)], z_, tol_, x0, x1)) continue;
+        const int i0 = first_at_or_after(x0, grid_.origin[0], grid_.pitch[0], nx);
+        const int i1 = last_at_or_before(x1, grid_.origin[0], grid_.pitch[0], nx);
+        if (i0 <= i1) act.push_back({c, lf.cell, i0, i1, -2, {}});
+      }
+      std::sort(act.begin(), act.end(), [](const RowLeaf& a, const RowLeaf& b) {
+        return a.cell < b.cell || (a.cell == b.cell && (a.i0 < b.i0 || (a.i0 == b.i0 && a.leaf < b.leaf)));
+      });
+      pos_[static_cast<std::size_t>(l)] = 0;
+    }
+    // Rows from the middle outwards, so the first anchors sit mid-block and serve every row.
+    int order[block_rows], n = 0;
+    for (int d = 0; n < nr; ++d) {
+      if (nr / 2 - d >= 0 && n < nr) order[n++] = nr / 2 - d;
+      if (d > 0 && nr / 2 + d < nr && n < nr) order[n++] = nr / 2 + d;
+    }
+    AnchorMaker maker(loc_, grid_, m_, nr, 0.5 * std::min({grid_.pitch[0], grid_.pitch[1], grid_.pitch[2]}));
+    maker_ = &maker;
+    for (std::size_t ci = 0; ci < cand_.size();) {
+      const int cell = leaves[static_cast<std::size_t>(cand_[ci])].cell;
+      while (ci < cand_.size() && leaves[static_cast<std::size_t>(cand_[ci])].cell == cell) ++ci;
+      anchors_.clear();
+      for (int o = 0; o < nr; ++o) walk_row(cell, order[o]);
+    }
+  }
+
+private:
+  /// The voxels of row l that cell `cell`'s leaves reach, in x order.
+  void walk_row(int cell, int l) {
+    const auto ul = static_cast<std::size_t>(l);
+    auto& act = act_[ul];
+    std::size_t g0 = pos_[ul];
+    while (g0 < act.size() && act[g0].cell < cell) ++g0;
+    std::size_t g1 = g0;
+    while (g1 < act.size() && act[g1].cell == cell) ++g1;
+    pos_[ul] = g1;
+    if (g0 == g1) return;
+    const auto unx = static_cast<std::size_t>(grid_.count[0]), um = static_cast<std::size_t>(m_);
+    std::int32_t* owner = out_->owner + ul * unx;
+    float* props = out_->props + ul * unx * um;
+    double* uvw = out_->uvw ? out_->uvw + ul * unx * 3 : nullptr;
+    const auto dom = loc_.domain(cell);
+    // Anchors made in earlier rows that cover this one, by first column.
+    cover_.clear();
+    for (std::size_t k = 0; k < anchors_.size(); ++k)
+      if (anchors_[k].lo[ul] <= anchors_[k].hi[ul]) cover_.push_back(static_cast<int>(k));
+    std::sort(cover_.begin(), cover_.end(), [&](int a, int b) { return anchors_[static_cast<std::size_t>(a)].lo[ul] < anchors_[static_cast<std::size_t>(b)].lo[ul]; });
+    std::size_t cp = 0;
+    int cur = -1;  // the anchor stepping now (index into anchors_)
+    Chain chain;
+    int prev_i = -2;
+    std::size_t next = g0;  // first leaf of the group not yet opened
+    int span_end = -1;
+    int i = act[g0].i0;
+    while (true) {
+      if (i > span_end) {
+        if (next >= g1) break;
+        if (act[next].i0 > i) i = act[next].i0;
+      }
+      while (next < g1 && act[next].i0 <= i) span_end = std::max(span_end, act[next++].i1);
+      if (i != prev_i + 1) chain.n = 0;
+      // 1. Certified stepping: a run of voxels without any evaluation.
+      if (cur < 0 || !anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
+        while (cp < cover_.size() && anchors_[static_cast<std::size_t>(cover_[cp])].hi[ul] < i) ++cp;
+        for (std::size_t q = cp; q < cover_.size() && anchors_[static_cast<std::size_t>(cover_[q])].lo[ul] <= i; ++q)
+          if (anchors_[static_cast<std::size_t>(cover_[q])].covers(l, i)) {
+            cur = cover_[q];
+            break;
+          }
+      }
+      if (cur >= 0 && anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
+        const Anchor& a = anchors_[static_cast<std::size_t>(cur)];
+        const int iend = std::min(a.hi[ul], span_end);
+        const double dl = l - a.la;
+        int j = i;
+        for (; j <= iend && owner[j] < 0; ++j) {
+          const double k = j - a.ia;
+          owner[j] = cell;
+          float* vp = props + static_cast<std::size_t>(j) * um;
+          for (std::size_t h = 0; h < um; ++h) vp[h] = static_cast<float>(a.pb[h] + k * a.pdx[h] + dl * a.pdy[h]);
+          if (uvw)
+            for (std::size_t d = 0; d < 3; ++d) uvw[static_cast<std::size_t>(j) * 3 + d] = a.tb[d] + k * a.dx[d] + dl * a.dy[d];
+        }
+        out_->inverted[ul] += j - i;
+        chain.n = 0;
+        if (j > i) {
+          prev_i = j - 1;
+          i = j;
+          continue;
+        }
+      }
+      prev_i = i;
+      if (owner[i] >= 0) {  // taken by an earlier cell
+        chain.n = 0;
+        ++i;
+        continue;
+      }
+      ++out_->inverted[ul];
+      visit(cell, l, i, dom, cur, chain, act.data() + g0, act.data() + next, owner[i], props + static_cast<std::size_t>(i) * um,
+            uvw ? uvw + static_cast<std::size_t>(i) * 3 : nullptr);
+      ++i;
+    }
+  }
+
+  /// One voxel off the stepping runs: an anchor at a prediction (its certification covers the
+  /// voxel, or its exact residual does), else the slow path (then an anchor at the answer).
+  void visit(int cell, int l, int i, const std::array<Vec3, 2>& dom, int& cur, Chain& chain, RowLeaf* lb, RowLeaf* le,
+             std::int32_t& owner, float* vp, double* vt) {
+    const auto ul = static_cast<std::size_t>(l);
+    const Vec3 p = {grid_.origin[0] + (i + 0.5) * grid_.pitch[0], y_[ul], z_};
+    auto accept = [&](const Vec3& t) {
+      owner = cell;
+      if (vt) std::copy(t.begin(), t.end(), vt);
+    };
+    // Stepping from a fresh anchor at voxel (i, l).
+    auto anchored = [&]() {
+      Anchor a;
+      if (!maker_->make(exp_, i, l, p, a)) return false;
+      anchors_.push_back(a);
+      cur = static_cast<int>(anchors_.size()) - 1;
+      if (!a.covers(l, i)) return false;
+      const Vec3 t = a.at(l, i);
+      const double k = i - a.ia, dl = l - a.la;
+      for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h) vp[h] = static_cast<float>(a.pb[h] + k * a.pdx[h] + dl * a.pdy[h]);
+      accept(t);
+      return true;
+    };
+    Vec3 t;
+    bool predicted = false;
+    if (cur >= 0) {
+      t = anchors_[static_cast<std::size_t>(cur)].at(l, i);
+      predicted = true;
+    } else if (chain.n > 0) {
+      predicted = chain.predict(dom, t);
+    } else if (!anchors_.empty()) {
+      // A run starts: the nearest anchor of the block (this cell) predicts well enough for Newton.
+      const double ry = grid_.pitch[1] / grid_.pitch[0];
+      std::size_t best = 0;
+      double bd = std::numeric_limits<double>::infinity();
+      for (std::size_t k = 0; k < anchors_.size(); ++k) {
+        const double d = std::abs(anchors_[k].ia - i) + ry * std::abs(anchors_[k].la - l);
+        if (d < bd) bd = d, best = k;
+      }
+      t = anchors_[best].at(l, i);
+      predicted = true;
+    }
+    cur = -1;
+    if (predicted && loc_.expand(cell, t, exp_)) {
+      if (anchored()) return;
+      const Vec3 rv{p[0] - exp_.x[0], p[1] - exp_.x[1], p[2] - exp_.x[2]};
+      if (rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2] < tol_ * tol_) {
+        for (int h = 0; h < m_; ++h) vp[h] = static_cast<float>(exp_.props[static_cast<std::size_t>(h)]);
+        accept(exp_.t);
+        chain.push_checked(exp_.t, rv, dom);
+        return;
+      }
+      t = exp_.t;
+    } else if (predicted) {
+      Vec3 rv;
+      if (loc_.check(cell, p, t, vp, &rv)) {
+        accept(t);
+        chain.push_checked(t, rv, dom);
+        return;
+      }
+    }
+    // The slow path: Newton, then the leaves.
+    c_slow++;
+    const Outcome o = solve_voxel(loc_, grid_, cell, i, p, predicted ? &t : nullptr, chain, t, lb, le, dom, out_->failures[ul]);
+    if (o == Outcome::outside) {
+      std::fill(vp, vp + m_, 0.0f);  // an evaluation above may have written there
+      cur = -1;
+      return;
+    }
+    if (o == Outcome::inside && loc_.expand(cell, chain.uvw[0], exp_) && anchored()) return;
+    accept(t);
+    loc_.eval_properties(cell, t, vp);
+  }
+
+  const Locator& loc_;
+  const VoxelGrid& grid_;
+  int m_;
+  BlockOut* out_ = nullptr;
+  double tol_ = 0.0, z_ = 0.0;
+  std::array<double, block_rows> y_{};
+  std::vector<int> cand_;
+  std::array<std::vector<RowLeaf>, block_rows> act_;
+  std::array<std::size_t, block_rows> pos_{};
+  std::vector<Anchor> anchors_;
+  std::vector<int> cover_;
+  AnchorMaker* maker_ = nullptr;
+  Expansion exp_;
+};
+
+}  // namespace
+
+LayerSampler::LayerSampler(const vmodel::VModel& model, const VoxelGrid& grid, SamplerOptions opt)
+    : grid_(grid), opt_(opt), locator_(model, options_for(grid)) {
+  if (grid.count[0] < 1 || grid.count[1] < 1 || grid.count[2] < 1)
+    throw Error("voxel grid of " + std::to_string(grid.count[0]) + " x " + std::to_string(grid.count[1]) + " x " +
+                std::to_string(grid.count[2]) + " voxels; expected at least one along each axis");
+}
+
+void LayerSampler::sample(int layer, int row0, int rows, RowBand& out) const {
+  const int nx = grid_.count[0], ny = grid_.count[1], nz = grid_.count[2];
+  if (layer < 0 || layer >= nz)
+    throw Error("layer " + std::to_string(layer) + "; expected 0 <= layer < " + std::to_string(nz));
+  if (row0 < 0 || rows < 0 || row0 > ny || rows > ny - row0)
+    throw Error("image rows [" + std::to_string(row0) + ", " + std::to_string(static_cast<long long>(row0) + rows) +
+                "); expected a range within [0, " + std::to_string(ny) + ")");
+  const int m = static_cast<int>(locator_.model().properties.size());
+  const auto unx = static_cast<std::size_t>(nx), um = static_cast<std::size_t>(m);
+  out.layer = layer;
+  out.row0 = row0;
+  out.rows = rows;
+  out.nx = nx;
+  out.nprops = m;
+  out.cell.resize(static_cast<std::size_t>(rows) * unx);
+  out.props.resize(static_cast<std::size_t>(rows) * unx * um);
+  if (opt_.keep_uvw)
+    out.uvw.resize(static_cast<std::size_t>(rows) * unx * 3);
+  else
+    out.uvw.clear();
+  out.failures = 0;
+  out.inverted = 0;
+  if (rows == 0) return;
+  BlockSampler bs(locator_, grid_);
+  std::vector<std::int32_t> owner;
+  std::vector<float> props;
+  std::vector<double> uvw;
+  for (int b = row0 / block_rows; b * block_rows < row0 + rows; ++b) {
+    const int r0 = b * block_rows, nr = std::min(block_rows, ny - r0);
+    const int from = std::max(r0, row0), to = std::min(r0 + nr, row0 + rows);
+    BlockOut blk;
+    const bool direct = from == r0 && to == r0 + nr;  // the whole block is in the band
+    if (direct) {
+      const auto dst = static_cast<std::size_t>(r0 - row0);
+      blk.owner = out.cell.data() + dst * unx;
+      blk.props = out.props.data() + dst * unx * um;
+      blk.uvw = opt_.keep_uvw ? out.uvw.data() + dst * unx * 3 : nullptr;
+    } else {
+      owner.resize(static_cast<std::size_t>(nr) * unx);
+      props.resize(static_cast<std::size_t>(nr) * unx * um);
+      if (opt_.keep_uvw) uvw.resize(static_cast<std::size_t>(nr) * unx * 3);
+      blk.owner = owner.data();
+      blk.props = props.data();
+      blk.uvw = opt_.keep_uvw ? uvw.data() : nullptr;
+    }
+    bs.run(layer, r0, nr, blk);
+    for (int r = from; r < to; ++r) {
+      const auto src = static_cast<std::size_t>(r - r0), dst = static_cast<std::size_t>(r - row0);
+      if (!direct) {
+        std::copy_n(owner.data() + src * unx, unx, out.cell.data() + dst * unx);
+        std::copy_n(props.data() + src * unx * um, unx * um, out.props.data() + dst * unx * um);
+        if (opt_.keep_uvw) std::copy_n(uvw.data() + src * unx * 3, unx * 3, out.uvw.data() + dst * unx * 3);
+      }
+      out.failures += blk.failures[src];
+      out.inverted += blk.inverted[src];
+    }
+  }
+}
+
+}  // namespace trivox::slice

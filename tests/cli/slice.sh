@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# End-to-end: `trivox slice` writes a Voxel Print stack that independent readers (OpenImageIO's
+# Python module, Python's XML parser) agree with.
+# Truth: the Fichera corner [-1,1]^3 minus the positive octant at pitch 0.254 mm (100 dpi, 0.254 mm
+# layers) has 8 voxel centres per axis at -1 + (i + 1/2) 0.254, none on a face: 8^3 - 4^3 = 448
+# voxels inside.
+set -euo pipefail
+trivox=$1
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --threads 1 --progress never --json > "$tmp/f1.json"
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/f2" --dpi 100,100 --layer 0.254 --threads 2 --progress never > /dev/null
+for f in "$tmp"/f1/*; do cmp "$f" "$tmp/f2/$(basename "$f")"; done   # identical for 1 and 2 threads
+[ "$(ls "$tmp/f1" | wc -l)" -eq "$(ls "$tmp/f2" | wc -l)" ]
+
+"$py" - "$tmp/f1" "$tmp/f1.json" <<'PY'
+import sys, os, json, glob
+import xml.etree.ElementTree as ET
+import OpenImageIO as oiio
+d, summary = sys.argv[1], json.load(open(sys.argv[2]))
+root = ET.parse(os.path.join(d, "ConfigFile.xml")).getroot()
+def find(tag):
+    e = root.find(".//" + tag)
+    assert e is not None, tag
+    return e.text.strip()
+w, h, n = int(find("SliceWidth")), int(find("SliceHeight")), int(find("NumberOfSlices"))
+assert (w, h, n) == (8, 8, 8), (w, h, n)
+prefix = find("ImageFilePrefix")
+slices = sorted(glob.glob(os.path.join(d, prefix + "*.png")))
+assert len(slices) == n, slices
+palette = {}
+for m in root.iter("Material"):
+    name = m.find("Name").text.strip()
+    rgba = tuple(int(x) for x in m.find("RGBA").text.split())
+    palette[rgba] = [name, int(m.find("VoxelCount").text), 0]
+filled = 0
+for path in slices:
+    inp = oiio.ImageInput.open(path)
+    spec = inp.spec()
+    assert (spec.width, spec.height, spec.nchannels) == (w, h, 4), path
+    assert abs(spec.get_float_attribute("XResolution") - 100) < 1e-3, spec.get_float_attribute("XResolution")  # pHYs holds pixels per metre
+    px = inp.read_image(format="uint8")
+    inp.close()
+    for row in px:
+        for p in row:
+            p = tuple(int(c) for c in p)
+            if p[3] == 0:
+                continue
+            assert p in palette, p
+            palette[p][2] += 1
+            filled += 1
+assert filled == 448, filled
+for rgba, (name, cfg_count, seen) in palette.items():
+    assert cfg_count == seen, (name, cfg_count, seen)
+assert summary["filled"] == 448 and summary["inversion_failures"] == 0, summary
+PY
+
+# Refusals: exit 2 with the reason.
+expect_fail() {
+  local pattern=$1; shift
+  set +e
+  "$@" > "$tmp/out" 2> "$tmp/err"
+  local rc=$?
+  set -e
+  if [ $rc -ne 2 ]; then echo "expected exit 2, got $rc: $*"; cat "$tmp/err"; exit 1; fi
+  grep -q -- "$pattern" "$tmp/err" || { echo "message lacks '$pattern': $*"; cat "$tmp/err"; exit 1; }
+}
+expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never
+expect_fail "unknown printer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --printer j9000
+expect_fail "expected 10 to 10000" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x2" --dpi 0,100
+expect_fail "expected a layer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x3" --layer -1
+expect_fail "expected fs, stochastic or none" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x4" --dither blue
+expect_fail "voxels" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x5" --max-voxels 100
+echo '{"materials": 3}' > "$tmp/bad-palette.json"
+expect_fail "bad-palette.json" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x6" --palette "$tmp/bad-palette.json"
+expect_fail "no cells" "$trivox" slice models/gismo/teapot.xml -o "$tmp/x7"
+# --force overwrites.
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never --force > /dev/null
+echo "cli slice: ok"

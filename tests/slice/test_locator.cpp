@@ -1,0 +1,158 @@
+// Point location against geometry known in closed form: axis-aligned boxes, a rational quarter
+// annulus (exact circles: inside iff r1 <= |(x,y)| <= r2, x, y >= 0, 0 <= z <= h), and a curved
+// tricubic block, where the located (u,v,w) must map back onto the point.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <random>
+
+#include "locator_fixtures.hpp"
+#include "trivox/error.hpp"
+#include "trivox/io/model_file.hpp"
+#include "trivox/slice/locator.hpp"
+
+using namespace trivox;
+using namespace trivox::test;
+using slice::Locator;
+using slice::Vec3;
+
+namespace {
+double dist(const double* x, const Vec3& p) {
+  return std::sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) + (x[2] - p[2]) * (x[2] - p[2]));
+}
+}  // namespace
+
+TEST_CASE("locate: a box cell, inside and outside") {
+  const auto m = model_of({box_cell({1, 2, 3}, {4, 6, 8}, {0.25})}, {"a"});
+  const Locator loc(m);
+  const auto r = loc.locate({2.5, 3, 7});
+  REQUIRE(r.inside);
+  CHECK(r.converged);
+  CHECK(r.cell == 0);
+  // Trilinear box: u = (x - 1) / 3, v = (y - 2) / 4, w = (z - 3) / 5.
+  CHECK(r.uvw[0] == Approx(0.5).margin(1e-6));
+  CHECK(r.uvw[1] == Approx(0.25).margin(1e-6));
+  CHECK(r.uvw[2] == Approx(0.8).margin(1e-6));
+  for (const Vec3 p : {Vec3{0.9, 3, 4}, Vec3{4.001, 3, 4}, Vec3{2, 1.99, 4}, Vec3{2, 3, 8.01}, Vec3{100, 100, 100}}) {
+    const auto o = loc.locate(p);
+    CHECK_FALSE(o.inside);
+    CHECK(o.cell == -1);
+    CHECK(o.converged);
+  }
+  // On a face (within the tolerance) counts as inside.
+  CHECK(loc.locate({4.0, 3, 4}).inside);
+}
+
+TEST_CASE("locate: rational quarter annulus agrees with the analytic inside test") {
+  const double r1 = 5, r2 = 10, h = 4;
+  const auto m = model_of({quarter_annulus(r1, r2, h)}, {"v"});
+  slice::LocatorOptions opt;
+  opt.tolerance = 1e-6;
+  const Locator loc(m, opt);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> X(-1, 11), Z(-1, 5);
+  int inside = 0, checked = 0;
+  for (int n = 0; n < 4000; ++n) {
+    const Vec3 p{X(rng), X(rng), Z(rng)};
+    const double rho = std::hypot(p[0], p[1]);
+    // Distance to the boundary, to skip points within the tolerance of it.
+    const double margin = std::min({std::abs(rho - r1), std::abs(rho - r2), std::abs(p[0]), std::abs(p[1]), std::abs(p[2]), std::abs(p[2] - h)});
+    if (margin < 1e-5) continue;
+    const bool truth = rho > r1 && rho < r2 && p[0] > 0 && p[1] > 0 && p[2] > 0 && p[2] < h;
+    const auto r = loc.locate(p);
+    INFO("p = " << p[0] << ", " << p[1] << ", " << p[2]);
+    CHECK(r.converged);
+    REQUIRE(r.inside == truth);
+    ++checked;
+    if (!truth) continue;
+    ++inside;
+    double x[3], v;
+    loc.eval(0, r.uvw, x, &v);
+    CHECK(dist(x, p) < opt.tolerance);
+    // The radial parameter is linear in the radius; the property equals it.
+    CHECK(r.uvw[1] == Approx((rho - r1) / (r2 - r1)).margin(1e-6));
+    CHECK(v == Approx(r.uvw[1]).margin(1e-12));
+    CHECK(r.uvw[2] == Approx(p[2] / h).margin(1e-6));
+  }
+  CHECK(checked > 3900);
+  CHECK(inside > 500);
+}
+
+TEST_CASE("locate: curved tricubic cell maps the located (u,v,w) back onto the point") {
+  const auto m = model_of({curved_tricubic()}, {"r", "g", "b"});
+  const auto& cell = m.cells[0].volume;
+  slice::LocatorOptions opt;
+  opt.tolerance = 1e-5;
+  const Locator loc(m, opt);
+  // Points of the cell at known parameters: locate must find them, with equal properties.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> U(0.001, 0.999);
+  slice::LocateResult prev;
+  for (int n = 0; n < 2000; ++n) {
+    const Vec3 t{U(rng), U(rng), U(rng)};
+    const auto x = cell.eval(t);
+    const Vec3 p{x[0], x[1], x[2]};
+    const auto r = n % 2 ? loc.locate(p, &prev) : loc.locate(p);  // with and without a hint
+    REQUIRE(r.inside);
+    CHECK(r.converged);
+    const auto y = cell.eval(r.uvw);
+    CHECK(dist(y.data(), p) < opt.tolerance);
+    // The map is injective (positive Jacobian), so the parameters are the ones we started from.
+    for (int d = 0; d < 3; ++d) CHECK(r.uvw[static_cast<std::size_t>(d)] == Approx(t[static_cast<std::size_t>(d)]).margin(1e-4));
+    double props[3], xyz[3];
+    loc.eval(0, r.uvw, xyz, props);
+    for (int h = 0; h < 3; ++h) CHECK(std::abs(props[h] - y[static_cast<std::size_t>(3 + h)]) < 1e-12);
+    prev = r;
+  }
+  // Outside: beyond the corners, which the corner control points pin down exactly.
+  CHECK_FALSE(loc.locate({-0.01, -0.01, -0.01}).inside);
+  CHECK_FALSE(loc.locate({10.01, 10.01, 10.01}).inside);
+  CHECK_FALSE(loc.locate({50, 5, 5}).inside);
+}
+
+TEST_CASE("locate: overlapping cells, the first in file order wins") {
+  const auto a = box_cell({0, 0, 0}, {2, 2, 2}, {1});
+  const auto b = box_cell({1, 1, 1}, {3, 3, 3}, {2});
+  const Locator ab(model_of({a, b}, {"p"}));
+  CHECK(ab.locate({1.5, 1.5, 1.5}).cell == 0);
+  CHECK(ab.locate({2.5, 2.5, 2.5}).cell == 1);
+  CHECK(ab.locate({0.5, 0.5, 0.5}).cell == 0);
+  const Locator ba(model_of({b, a}, {"p"}));
+  CHECK(ba.locate({1.5, 1.5, 1.5}).cell == 0);
+  CHECK(ba.locate({0.5, 0.5, 0.5}).cell == 1);
+  // A hint into the later cell does not override the earlier one.
+  const auto hint = ab.locate({2.5, 2.5, 2.5});
+  CHECK(ab.locate({1.5, 1.5, 1.5}, &hint).cell == 0);
+}
+
+TEST_CASE("locate: the Fichera corner's seven cubes") {
+  const auto m = io::load_model(std::filesystem::path(TRIVOX_SOURCE_DIR) / "models" / "gismo" / "fichera.xml");
+  const Locator loc(m);
+  // The corner is [-1,1]^3 without one octant; every cube's centre is found in that cube.
+  for (std::size_t c = 0; c < m.cells.size(); ++c) {
+    const auto x = m.cells[c].volume.eval({0.5, 0.5, 0.5});
+    const auto r = loc.locate({x[0], x[1], x[2]});
+    CHECK(r.inside);
+    CHECK(r.cell == static_cast<int>(c));
+  }
+  int missing = 0;
+  for (int o = 0; o < 8; ++o) {
+    const Vec3 p{o & 1 ? 0.5 : -0.5, o & 2 ? 0.5 : -0.5, o & 4 ? 0.5 : -0.5};
+    missing += !loc.locate(p).inside;
+  }
+  CHECK(missing == 1);
+}
+
+TEST_CASE("locate: bad options and cells are reported") {
+  const auto m = model_of({box_cell({0, 0, 0}, {1, 1, 1})});
+  slice::LocatorOptions opt;
+  opt.tolerance = 0;
+  CHECK_THROWS_AS(Locator(m, opt), Error);
+  auto bad = m;
+  bad.properties = {"r"};  // the cell has 3 coordinates, the model says 4
+  CHECK_THROWS_WITH(Locator(bad), Catch::Contains("cell0") && Catch::Contains("expected 4"));
+  CHECK_THROWS_AS(slice::model_bounds(vmodel::VModel{}), Error);
+  const auto b = slice::model_bounds(model_of({box_cell({1, 2, 3}, {4, 5, 6}), box_cell({-1, 0, 0}, {0, 7, 1})}));
+  CHECK(b[0] == Vec3{-1, 0, 0});
+  CHECK(b[1] == Vec3{4, 7, 6});
+}

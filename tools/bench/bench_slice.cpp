@@ -1,0 +1,130 @@
+// The print job's speed and memory (issue 3's benchmark), on the demo model (four tricubic cells
+// with an rgb field) or a model given on the command line.
+//
+// 1. The whole job at J750 settings with 2 threads, against the floor: encoding and writing the
+//    same PNGs from memory with the same settings and threads (the slices are decoded back first,
+//    untimed). Prints seconds, voxels per second and the ratio job / floor.
+// 2. One 1516 x 2524 pixel slice (the papers' example size): the model scaled to 64.2 x 213.7 mm
+//    in xy and to one layer in z, sliced on one thread.
+// 3. Peak memory of a full-tray-width J750 layer (11,575 x 4,606 px): the model scaled to the
+//    tray (490 x 390 mm) and to `tray_layers` layers; ru_maxrss after the job (run first).
+//
+// Usage: trivox_bench_slice [MODEL [LAYERS_FOR_STEP_1 [TRAY_LAYERS]]]
+//   LAYERS_FOR_STEP_1: scale the model's height to this many J750 layers (0: keep its height).
+#include <sys/resource.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "trivox/io/model_file.hpp"
+#include "trivox/io/slice_job.hpp"
+#include "trivox/io/slice_stack.hpp"
+#include "trivox/slice/sampler.hpp"
+
+using namespace trivox;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// The model with xyz mapped affinely so its box becomes [0, size] (a size of 0 keeps the axis).
+vmodel::VModel scaled(const vmodel::VModel& m, std::array<double, 3> size) {
+  const auto box = slice::model_bounds(m);
+  vmodel::VModel out = m;
+  for (auto& c : out.cells)
+    for (int r = 0; r < c.volume.size(); ++r) {
+      auto p = c.volume.point(r);
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double ext = box[1][d] - box[0][d];
+        if (size[d] > 0 && ext > 0) p[d] = (p[d] - box[0][d]) * size[d] / ext;
+      }
+    }
+  return out;
+}
+
+io::SliceJobSummary run(const vmodel::VModel& m, const fs::path& dir, int threads) {
+  fs::remove_all(dir);
+  io::SliceJobOptions opt;
+  opt.profile = slice::printer_preset("j750");
+  opt.out_dir = dir;
+  opt.force = true;
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  return io::run_slice_job(m, opt);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const fs::path model_path = argc > 1 ? argv[1] : "models/twisted_column.json";
+  const int layers = argc > 2 ? std::atoi(argv[2]) : 0;
+  const int tray_layers = argc > 3 ? std::atoi(argv[3]) : 2;
+  const fs::path tmp = fs::temp_directory_path() / "trivox-bench-slice";
+  vmodel::VModel model = io::load_model(model_path);
+  if (layers > 0) model = scaled(model, {0, 0, layers * 0.027});
+
+  // 3 (run first, so the peak is this job's). Peak memory for full-tray-width layers.
+  {
+    const auto tray = scaled(model, {490.0 - 1e-6, 390.0 - 1e-6, tray_layers * 0.027});
+    const auto s = run(tray, tmp / "tray", 2);
+    rusage ru{};
+    getrusage(RUSAGE_SELF, &ru);
+    std::printf("%-44s %12.3f %14.4g\n",
+                ("tray " + std::to_string(s.grid.count[0]) + " x " + std::to_string(s.grid.count[1]) + " x " +
+                 std::to_string(s.grid.count[2]))
+                    .c_str(),
+                s.seconds, s.voxels / s.seconds);
+    std::printf("peak memory of the tray job (ru_maxrss): %.1f MB\n", ru.ru_maxrss / 1024.0);
+  }
+  // 1. The job against the floor.
+  const auto job = run(model, tmp / "job", 2);
+  std::vector<std::string> names;
+  std::vector<io::RgbaImage> images;
+  const auto cfg = io::read_stack_config(tmp / "job");
+  for (int i = 0; i < cfg.slices; ++i) {
+    names.push_back(cfg.slice_name(i));
+    images.push_back(io::decode_png_rgba(io::read_file(tmp / "job" / names.back()), names.back()));
+  }
+  fs::create_directories(tmp / "floor");
+  double floor_s;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    const auto t0 = Clock::now();
+    tbb::parallel_for(std::size_t{0}, images.size(), [&](std::size_t i) {
+      const auto& im = images[i];
+      io::write_file_atomically(tmp / "floor" / names[i],
+                                io::encode_png_rgba(im.pixels.data(), im.width, im.height, cfg.dpi_x, cfg.dpi_y));
+    });
+    floor_s = since(t0);
+  }
+  std::printf("trivox bench_slice: %s, J750 600 x 300 dpi, 27 um layers, 2 threads\n", model_path.c_str());
+  std::printf("%-44s %12s %14s %8s\n", "step", "seconds", "voxels/s", "ratio");
+  std::printf("%-44s %12.3f %14.4g %8s\n",
+              ("job: " + std::to_string(job.grid.count[0]) + " x " + std::to_string(job.grid.count[1]) + " x " +
+               std::to_string(job.grid.count[2]))
+                  .c_str(),
+              job.seconds, job.voxels / job.seconds, "");
+  std::printf("%-44s %12.3f %14.4g %8.2f\n", "floor: encode + write the same PNGs", floor_s, job.voxels / floor_s,
+              job.seconds / floor_s);
+  std::printf("inversion failures: %lld\n", static_cast<long long>(job.inversion_failures));
+
+  // 2. One 1516 x 2524 slice on one thread.
+  {
+    const auto one = scaled(model, {1516 * 25.4 / 600, 2524 * 25.4 / 300, 0.027});
+    const auto s = run(one, tmp / "one", 1);
+    std::printf("%-44s %12.3f %14.4g\n",
+                ("one slice " + std::to_string(s.grid.count[0]) + " x " + std::to_string(s.grid.count[1]) +
+                 ", 1 thread")
+                    .c_str(),
+                s.seconds, s.voxels / s.seconds);
+  }
+  fs::remove_all(tmp);
+  return 0;
+}
