@@ -557,7 +557,7 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
       const auto ud = static_cast<std::size_t>(d), ue = static_cast<std::size_t>(e);
       const double factor = d == e ? (o[ud] - 1.0) * (o[ud] - 2.0) * pc.inv_len[ud] * pc.inv_len[ud]
                                    : (o[ud] - 1.0) * (o[ue] - 1.0) * pc.inv_len[ud] * pc.inv_len[ue];
-      double bx = 0.0, bp = 0.0;
+      double bx = 0.0, bp = 0.0, bv[3] = {0.0, 0.0, 0.0};
       if (factor != 0.0)
         for (int i = 0; i < n; ++i) {
           const int idx[3] = {i % o[0], (i / o[0]) % o[1], i / (o[0] * o[1])};
@@ -581,16 +581,19 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
           for (int h = 0; h < nc; ++h) {
             double v = 0.0;
             for (int k = 0; k < terms; ++k) v += w[k] * net[static_cast<std::size_t>(off[k] * nc + h)];
-            if (h < 3)
+            if (h < 3) {
               x2 += v * v;
-            else
+              bv[h] = std::max(bv[h], std::abs(v));
+            } else {
               bp = std::max(bp, std::abs(v));
+            }
           }
           bx = std::max(bx, std::sqrt(x2));
         }
       // Rounding in the differences is far below these bounds' slack; 1e-12 relative covers it.
       b.b2[ud][ue] = b.b2[ue][ud] = bx * factor * (1.0 + 1e-12);
-      b.p2 = std::max(b.p2, bp * factor * (1.0 + 1e-12));
+      for (std::size_t k = 0; k < 3; ++k) b.b2v[ud][ue][k] = b.b2v[ue][ud][k] = bv[k] * factor * (1.0 + 1e-12);
+      b.p2[ud][ue] = b.p2[ue][ud] = bp * factor * (1.0 + 1e-12);
     }
   (void)m;
   for (std::size_t d = 0; d < 3; ++d)
@@ -656,7 +659,11 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
       }
       pc.lipschitz[dd] = (pc.order[dd] - 1) * mx * pc.inv_len[dd];
     }
-    if (pc.k.all_first) pc.bounds = second_derivative_bounds(all, pc, m);
+    if (pc.k.all_first) {
+      pc.bounds = second_derivative_bounds(all, pc, m);
+      pc.bounds.slope = pc.lipschitz;
+      for (std::size_t d = 0; d < 3; ++d) pc.bounds.degree[d] = pc.order[d] - 1;
+    }
     std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
     build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.max_leaves_per_piece, lv);
     for (const auto& [box, fl] : lv) {
@@ -1014,6 +1021,7 @@ NewtonResult Locator::solve_in_leaf(int leaf, const Vec3& p, const Vec3* start) 
 }
 
 LocateResult Locator::locate(const Vec3& p, const LocateResult* hint) const {
+  if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) return {false, -1, {}, false};
   std::vector<int> cand;
   query(p, p, opt_.tolerance, cand);
   LocateResult out;

@@ -7,10 +7,7 @@
 
 #include "trivox/error.hpp"
 
-#include <atomic>
-#include <atomic>
 namespace trivox::slice {
-std::atomic<long> c_anchors, c_block, c_row, c_K, c_K1, c_fail, c_slow, c_expand;
 
 namespace {
 
@@ -25,8 +22,8 @@ LocatorOptions options_for(const VoxelGrid& grid) {
     throw Error("voxel pitch " + std::to_string(pmin) + " mm; expected positive finite pitches");
   LocatorOptions o;
   o.tolerance = 1e-3 * pmin;
-  // Leaves hugging the cells to within two voxels: little empty space left to invert.
-  o.leaf_deviation = 2.0 * std::max({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
+  // Leaves hugging the cells to within about a voxel: little empty space left to invert.
+  o.leaf_deviation = 1.0 * std::max({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
   return o;
 }
 
@@ -73,20 +70,18 @@ struct RowLeaf {
 /// Rows of a layer processed together: anchors certify rectangles of voxels spanning them.
 /// Blocks are aligned on multiples of this in image rows, and a band always computes whole
 /// blocks, so results never depend on the banding.
-constexpr int block_rows = 4;
+constexpr int block_rows = LayerSampler::block_rows;
 
 /// Certified first-order stepping from an anchor (an Expansion at voxel (ia, la) of a block):
 /// voxel (ia + k, la + l) gets t = t0 + J0^-1 (p - X0) = t0 + c0 + k dx + l dy and properties
-/// P0 + G0 (t - t0), accepted only when rigorous bounds show (Kantorovich) that the exact
-/// preimage t* of its centre lies within r of t inside the anchor's piece and that the
-/// properties are within 0.95/512 of P(t*). The bounds use the piece's second-derivative bounds
-/// (StepBounds): with d = t - t0, the Taylor remainder |X(t) - p| <= e = 1/2 sum b2_de |d_d| |d_e|;
-/// |J(t)^-1| <= beta0 / (1 - beta0 lip |d|_1) <= 2 beta0 while beta0 lip |d|_1 < 1/2; then a root
-/// lies within r = 2 (2 beta0) e when (2 beta0)^2 sqrt3 lip e <= 1/2. Bounding |d_j| by |c0_j| +
-/// |k| |dx_j| + |l| |dy_j| makes every bound grow with |k| and |l|, and the margin to the piece's
-/// box is affine in (k, l), so certifying the extreme |k|, |l| and the four corners certifies a
-/// whole rectangle: found once per anchor by doubling and bisection, after which a voxel costs a
-/// few multiply-adds.
+/// P0 + G0 (t - t0), accepted only when rigorous bounds show (Newton-Kantorovich, in Deuflhard's
+/// affine-covariant form, see AnchorMaker::certified) that the exact preimage t* of its centre
+/// lies within r of t inside the anchor's piece (or outside it by less than the tolerance) and
+/// that the properties are within 0.95/512 of P(t*). The bounds use the piece's bounds on second
+/// partials (StepBounds). Bounding |t_j - t0_j| by |c0_j| + |k| |dx_j| + |l| |dy_j| makes every
+/// bound grow with |k| and |l|, and the margin to the piece's box is affine in (k, l), so
+/// certifying the extreme |k|, |l| and the four corners certifies a whole rectangle: found once
+/// per anchor by doubling and bisection, after which a voxel costs a few multiply-adds.
 struct Anchor {
   int ia = 0, la = 0;                 ///< voxel column and block row of the expansion
   std::array<int, block_rows> lo{}, hi{};  ///< certified columns per block row (lo > hi: none)
@@ -104,7 +99,8 @@ struct Anchor {
 class AnchorMaker {
 public:
   AnchorMaker(const Locator& loc, const VoxelGrid& grid, int m, int rows, double max_residual)
-      : loc_(loc), m_(m), rows_(rows), px_(grid.pitch[0]), py_(grid.pitch[1]), max_residual_(max_residual), nx_(grid.count[0]) {}
+      : loc_(loc), m_(m), rows_(rows), px_(grid.pitch[0]), py_(grid.pitch[1]), max_residual_(max_residual),
+        tol_(loc.options().tolerance), nx_(grid.count[0]) {}
 
   /// An anchor at voxel (i, l) with centre p from the expansion e; false when nothing (not even
   /// the voxel itself) is certified.
@@ -120,12 +116,26 @@ public:
     a.dy = {-inv[0][1] * py_, -inv[1][1] * py_, -inv[2][1] * py_};  // the next image row is py lower
     dx_ = a.dx;
     dy_ = a.dy;
-    double f2 = 0.0;
-    for (const auto& row : inv) f2 += row[0] * row[0] + row[1] * row[1] + row[2] * row[2];
-    beta0_ = std::sqrt(f2);
-    gmax_ = 0.0;
+    // Affine-covariant bounds (Deuflhard): the second partials seen through J0^-1. With
+    // |J0^-1| taken entrywise, |J0^-1 v| <= | |J0^-1| b2v | for any v bounded entrywise by b2v,
+    // so w[d][e] bounds |J0^-1 d^2X/dt_d dt_e| in the whole piece, whatever the cell's shape
+    // (a layer-thin or sheared slab is as well conditioned as a cube).
+    std::array<Vec3, 3> ainv;
+    for (std::size_t r = 0; r < 3; ++r)
+      for (std::size_t k = 0; k < 3; ++k) ainv[r][k] = std::abs(inv[r][k]);
+    omega_ = 0.0;
+    for (std::size_t d = 0; d < 3; ++d) {
+      double row2 = 0.0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Vec3 v = mul(ainv, b_->b2v[d][k]);
+        w_[d][k] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        row2 += w_[d][k] * w_[d][k];
+      }
+      omega_ = std::max(omega_, std::sqrt(row2));  // |J0^-1 (J(x) - J(y))|_F <= omega |x - y|_1
+    }
+    gmax_ = {0.0, 0.0, 0.0};
     for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h)
-      gmax_ = std::max({gmax_, std::abs(e.grad[h][0]), std::abs(e.grad[h][1]), std::abs(e.grad[h][2])});
+      for (std::size_t d = 0; d < 3; ++d) gmax_[d] = std::max(gmax_[d], std::abs(e.grad[h][d]));
     for (std::size_t j = 0; j < 3; ++j) a.tb[j] = e.t[j] + c0_[j];
     for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h) {
       a.pb[h] = e.props[h] + e.grad[h][0] * c0_[0] + e.grad[h][1] * c0_[1] + e.grad[h][2] * c0_[2];
@@ -139,20 +149,26 @@ public:
     // covering most voxels wins.
     int best_up = 0, best_down = 0, best_k = -1, best_kn = 0;
     long best_area = 0;
-    auto consider = [&](int up, int down, bool both_ways, int& guess) {
-      const int K = largest([&](int k) { return certified(both_ways ? k : 0, k, up, down); }, guess);
+    auto consider = [&](int opt) {
+      const int up = opt == 0 ? l : opt == 1 ? std::min(l, 1) : 0;
+      const int down = opt == 0 ? rows_ - 1 - l : opt == 1 ? std::min(rows_ - 1 - l, 1) : 0;
+      const bool both_ways = opt < 2;
+      const auto uo = static_cast<std::size_t>(opt);
+      const int K = largest([&](int k) { return certified(both_ways ? k : 0, k, up, down); }, guess_[uo]);
       if (K < 0) return;
-      guess = K;
+      guess_[uo] = K;
       const long area = static_cast<long>(both_ways ? 2 * K + 1 : K + 1) * (up + down + 1);
       if (area > best_area) {
         best_area = area;
         best_up = up, best_down = down, best_k = K, best_kn = both_ways ? K : 0;
       }
     };
-    consider(l, rows_ - 1 - l, true, guess_[0]);
-    if (rows_ > 2) consider(std::min(l, 1), std::min(rows_ - 1 - l, 1), true, guess_[1]);
-    consider(0, 0, false, guess_[2]);
-    c_anchors++; if (best_up + best_down > 0) c_block++; else c_row++; c_K += best_k; c_K1 += best_up + best_down + 1;
+    // The whole block first; the narrower shapes only when it spans few columns.
+    consider(0);
+    if (best_k < 2) {
+      if (rows_ > 2) consider(1);
+      consider(2);
+    }
     if (best_k < 0) return false;
     for (int r = l - best_up; r <= l + best_down; ++r) {
       a.lo[static_cast<std::size_t>(r)] = std::max(0, i - best_kn);
@@ -193,40 +209,84 @@ private:
   }
 
   /// Whether every voxel (ia + k, la + l), -kn <= k <= kp, -ln <= l <= lp, is certified.
+  /// Newton-Kantorovich for G(t) = J0^-1 (X(t) - p) from the voxel's linear-model parameters t
+  /// (d = t - t0, |d_j| <= a_j): |G(t)| <= eta = 1/2 sum w_de a_d a_e (Taylor); G' = J0^-1 J moves
+  /// by at most omega |d|_1 <= 1/2 from the identity, so |G'(t)^-1| <= 2; G' is Lipschitz with
+  /// sqrt3 omega in the 2-norm; then h = 2 (sqrt3 omega) 2 eta <= 1/2 puts the root within
+  /// r = 2 (2 eta) of t.
   bool certified(int kn, int kp, int ln, int lp) const {
+    // Bounds hold in the piece's box; where the certificate reaches out of it (a voxel on or
+    // next to a face) they are retried with every bound scaled by 1.01, valid as long as the
+    // reach outside keeps the polynomial growth below that factor.
+    const int first = certified_with(kn, kp, ln, lp, 1.0);
+    return first > 0 || (first < 0 && certified_with(kn, kp, ln, lp, 1.01) > 0);
+  }
+
+  /// 1: certified; 0: not; -1: the certificate leaves the box (retry with a growth factor G).
+  int certified_with(int kn, int kp, int ln, int lp, double G) const {
     const double K = std::max(kn, kp), L = std::max(ln, lp);
     const Vec3 a{std::abs(c0_[0]) + K * std::abs(dx_[0]) + L * std::abs(dy_[0]),
                  std::abs(c0_[1]) + K * std::abs(dx_[1]) + L * std::abs(dy_[1]),
                  std::abs(c0_[2]) + K * std::abs(dx_[2]) + L * std::abs(dy_[2])};
     const double s1 = a[0] + a[1] + a[2];
-    if (!(beta0_ * b_->lip * s1 < 0.5)) return false;
+    const double omega = G * omega_;
+    if (!(omega * s1 <= 0.5)) return 0;
     const auto& B = b_->b2;
-    const double e2 = 0.5 * (B[0][0] * a[0] * a[0] + B[1][1] * a[1] * a[1] + B[2][2] * a[2] * a[2]) +
-                      B[0][1] * a[0] * a[1] + B[0][2] * a[0] * a[2] + B[1][2] * a[1] * a[2];
-    if (!(e2 <= max_residual_)) return false;
-    const double beta = 2.0 * beta0_;
-    const double eta = beta * e2;
-    if (!(beta * sqrt3 * b_->lip * eta <= 0.5)) return false;
-    const double r = 2.0 * eta;
+    const double e2 = G * (0.5 * (B[0][0] * a[0] * a[0] + B[1][1] * a[1] * a[1] + B[2][2] * a[2] * a[2]) +
+                           B[0][1] * a[0] * a[1] + B[0][2] * a[0] * a[2] + B[1][2] * a[1] * a[2]);
+    if (!(e2 <= max_residual_)) return 0;  // keeps the (u,v,w) reported meaningful
+    const double eta = G * (0.5 * (w_[0][0] * a[0] * a[0] + w_[1][1] * a[1] * a[1] + w_[2][2] * a[2] * a[2]) +
+                            w_[0][1] * a[0] * a[1] + w_[0][2] * a[0] * a[2] + w_[1][2] * a[1] * a[2]);
+    if (!(4.0 * sqrt3 * omega * eta <= 0.5)) return 0;
+    const double R = 4.0 * eta;
+    const Vec3 r{R, R, R};
+    // How far the parameters and the ball around them leave the piece's box, per direction.
+    // Leaving it by delta puts the root t* of the piece's polynomial up to delta outside, where
+    // its point is still within slope * delta of the cell: allowed while that stays below the
+    // tolerance (the contract leaves such voxels either way), so that a layer through a face is
+    // certified like any other. Outside the box a polynomial of degree n grows by at most the
+    // Chebyshev factor T_n(1 + 2 delta / len) <= cosh(n sqrt(4 delta / len)).
+    Vec3 out{};
+    double grow = 1.0, off = 0.0;
     for (std::size_t j = 0; j < 3; ++j) {
       const double base = e_->t[j] + c0_[j];
       const double c[4] = {base - kn * dx_[j] - ln * dy_[j], base + kp * dx_[j] - ln * dy_[j], base - kn * dx_[j] + lp * dy_[j],
                            base + kp * dx_[j] + lp * dy_[j]};
       const double lo = std::min({c[0], c[1], c[2], c[3]}), hi = std::max({c[0], c[1], c[2], c[3]});
-      if (!(lo - r >= b_->lo[j] && hi + r <= b_->hi[j])) return false;
+      out[j] = std::max({0.0, hi + r[j] - b_->hi[j], b_->lo[j] - (lo - r[j])});
+      if (out[j] > 0.0) {
+        grow *= std::cosh(b_->degree[j] * std::sqrt(4.0 * out[j] / (b_->hi[j] - b_->lo[j])));
+        off += b_->slope[j] * out[j];
+      }
     }
-    const double perr = 0.5 * b_->p2 * s1 * s1 + (gmax_ + b_->p2 * (s1 + sqrt3 * r)) * sqrt3 * r;
-    return perr <= prop_budget;
+    if (off > 0.0) {
+      if (!(grow <= G)) return G > 1.0 ? 0 : -1;
+      if (!(grow * off <= tol_)) return 0;
+    }
+    // |P(t*) - model| <= Taylor remainder + sum_d (largest dP/dt_d near t) |t*_d - t_d|, plus,
+    // for t* outside the box, the change to the cell's nearest parameters.
+    const auto& P = b_->p2;
+    double grad_term = 0.0;
+    for (std::size_t d = 0; d < 3; ++d) {
+      const double g = gmax_[d] + G * (P[d][0] * (a[0] + r[0]) + P[d][1] * (a[1] + r[1]) + P[d][2] * (a[2] + r[2]));
+      grad_term += g * (r[d] + out[d]);
+    }
+    const double perr = G * (0.5 * (P[0][0] * a[0] * a[0] + P[1][1] * a[1] * a[1] + P[2][2] * a[2] * a[2]) +
+                             P[0][1] * a[0] * a[1] + P[0][2] * a[0] * a[2] + P[1][2] * a[1] * a[2]) +
+                        grad_term;
+    return perr <= prop_budget ? 1 : 0;
   }
 
   const Locator& loc_;
   int m_, rows_;
-  double px_, py_, max_residual_;
+  double px_, py_, max_residual_, tol_;
   int nx_;
   const StepBounds* b_ = nullptr;
   const Expansion* e_ = nullptr;
   Vec3 c0_{}, dx_{}, dy_{};
-  double beta0_ = 0.0, gmax_ = 0.0;
+  Vec3 gmax_{};                 ///< largest |dP_h/dt_d| at the anchor
+  std::array<Vec3, 3> w_{};     ///< bounds on |J0^-1 d^2X/dt_d dt_e|
+  double omega_ = 0.0;
   std::array<int, 3> guess_{-1, -1, -1};
 };
 
@@ -267,6 +327,7 @@ struct Chain {
     have_inv = invert(res.jacobian, inv);
     push(res.polished);
   }
+  void set_jacobian(const std::array<Vec3, 3>& jac) { have_inv = invert(jac, inv); }
 };
 
 enum class Outcome { inside, guessed, outside };
@@ -274,11 +335,16 @@ enum class Outcome { inside, guessed, outside };
 /// The slow path for one voxel: Newton over the cell from a prediction (when there is one), then
 /// the leaves whose intervals hold the voxel, each warm-started from its own answer at the
 /// previous voxel (Locator::solve_in_leaf, with its subdivision fallback).
-Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, const Vec3& p, const Vec3* start, Chain& chain,
-                    Vec3& t, RowLeaf* leaves_begin, RowLeaf* leaves_end, const std::array<Vec3, 2>& dom, std::int64_t& failures) {
+/// @param start        a prediction, or null
+/// @param cell_newton  run Newton over the cell from the prediction first (else the prediction
+///                     only warm-starts the leaves that have no answer at the previous voxel)
+Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, const Vec3& p, const Vec3* start, bool cell_newton,
+                    Chain& chain, Vec3& t, RowLeaf* leaves_begin, RowLeaf* leaves_end, const std::array<Vec3, 2>& dom,
+                    std::int64_t& failures) {
   NewtonResult res;
-  if (start) res = loc.newton(cell, p, *start, dom[0], dom[1], 6);
-  if (!start || res.status != NewtonStatus::converged) {
+  if (start) res.uvw = *start;
+  if (start && cell_newton) res = loc.newton(cell, p, *start, dom[0], dom[1], 6);
+  if (!start || !cell_newton || res.status != NewtonStatus::converged) {
     const Vec3 from = res.uvw;
     NewtonResult best;
     best.residual = std::numeric_limits<double>::infinity();
@@ -315,6 +381,40 @@ Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, 
   return Outcome::inside;
 }
 
+/// Fills voxels i0 .. i1 - 1 of block row l from anchor a (cell index, properties, uvw).
+/// M: properties known at compile time (-1: m).
+template <int M>
+void fill_run(const Anchor& a, int l, int i0, int i1, int cell, std::int32_t* owner, float* props, double* uvw, int m) {
+  const int n = M >= 0 ? M : m;
+  const double dl = l - a.la;
+  double base[Expansion::max_props];
+  for (int h = 0; h < n; ++h) base[h] = a.pb[static_cast<std::size_t>(h)] + dl * a.pdy[static_cast<std::size_t>(h)];
+  for (int j = i0; j < i1; ++j) {
+    const double k = j - a.ia;
+    owner[j] = cell;
+    float* vp = props + static_cast<std::ptrdiff_t>(j) * n;
+    for (int h = 0; h < n; ++h) vp[h] = static_cast<float>(base[h] + k * a.pdx[static_cast<std::size_t>(h)]);
+  }
+  if (uvw)
+    for (int j = i0; j < i1; ++j) {
+      const Vec3 t = a.at(l, j);
+      std::copy(t.begin(), t.end(), uvw + static_cast<std::ptrdiff_t>(j) * 3);
+    }
+}
+
+using FillRun = void (*)(const Anchor&, int, int, int, int, std::int32_t*, float*, double*, int);
+
+FillRun pick_fill(int m) {
+  switch (m) {
+    case 0: return fill_run<0>;
+    case 1: return fill_run<1>;
+    case 2: return fill_run<2>;
+    case 3: return fill_run<3>;
+    case 4: return fill_run<4>;
+    default: return fill_run<-1>;
+  }
+}
+
 /// Where a block's results go: rows of nx voxels, straight into the caller's band when the block
 /// lies inside it, else into scratch.
 struct BlockOut {
@@ -327,7 +427,8 @@ struct BlockOut {
 /// Samples image rows [r0, r0 + nr) of layer `layer` (one block) into `out`.
 class BlockSampler {
 public:
-  BlockSampler(const Locator& loc, const VoxelGrid& grid) : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())) {}
+  BlockSampler(const Locator& loc, const VoxelGrid& grid)
+      : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())), fill_(pick_fill(m_)) {}
 
   void run(int layer, int r0, int nr, BlockOut& out) {
     const int nx = grid_.count[0], ny = grid_.count[1];
@@ -405,6 +506,7 @@ private:
     std::size_t cp = 0;
     int cur = -1;  // the anchor stepping now (index into anchors_)
     Chain chain;
+    int check_run = 0;
     int prev_i = -2;
     std::size_t next = g0;  // first leaf of the group not yet opened
     int span_end = -1;
@@ -415,7 +517,7 @@ private:
         if (act[next].i0 > i) i = act[next].i0;
       }
       while (next < g1 && act[next].i0 <= i) span_end = std::max(span_end, act[next++].i1);
-      if (i != prev_i + 1) chain.n = 0;
+      if (i != prev_i + 1) chain.n = check_run = 0;
       // 1. Certified stepping: a run of voxels without any evaluation.
       if (cur < 0 || !anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
         while (cp < cover_.size() && anchors_[static_cast<std::size_t>(cover_[cp])].hi[ul] < i) ++cp;
@@ -428,16 +530,9 @@ private:
       if (cur >= 0 && anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
         const Anchor& a = anchors_[static_cast<std::size_t>(cur)];
         const int iend = std::min(a.hi[ul], span_end);
-        const double dl = l - a.la;
         int j = i;
-        for (; j <= iend && owner[j] < 0; ++j) {
-          const double k = j - a.ia;
-          owner[j] = cell;
-          float* vp = props + static_cast<std::size_t>(j) * um;
-          for (std::size_t h = 0; h < um; ++h) vp[h] = static_cast<float>(a.pb[h] + k * a.pdx[h] + dl * a.pdy[h]);
-          if (uvw)
-            for (std::size_t d = 0; d < 3; ++d) uvw[static_cast<std::size_t>(j) * 3 + d] = a.tb[d] + k * a.dx[d] + dl * a.dy[d];
-        }
+        while (j <= iend && owner[j] < 0) ++j;  // the run: certified and not taken
+        fill_(a, l, i, j, cell, owner, props, uvw, m_);
         out_->inverted[ul] += j - i;
         chain.n = 0;
         if (j > i) {
@@ -453,7 +548,7 @@ private:
         continue;
       }
       ++out_->inverted[ul];
-      visit(cell, l, i, dom, cur, chain, act.data() + g0, act.data() + next, owner[i], props + static_cast<std::size_t>(i) * um,
+      visit(cell, l, i, dom, cur, chain, check_run, act.data() + g0, act.data() + next, owner[i], props + static_cast<std::size_t>(i) * um,
             uvw ? uvw + static_cast<std::size_t>(i) * 3 : nullptr);
       ++i;
     }
@@ -461,14 +556,26 @@ private:
 
   /// One voxel off the stepping runs: an anchor at a prediction (its certification covers the
   /// voxel, or its exact residual does), else the slow path (then an anchor at the answer).
-  void visit(int cell, int l, int i, const std::array<Vec3, 2>& dom, int& cur, Chain& chain, RowLeaf* lb, RowLeaf* le,
-             std::int32_t& owner, float* vp, double* vt) {
+  /// @param check_run  voxels left to try by a residual check alone (along a boundary, where
+  ///                   anchors certify nothing)
+  void visit(int cell, int l, int i, const std::array<Vec3, 2>& dom, int& cur, Chain& chain, int& check_run, RowLeaf* lb,
+             RowLeaf* le, std::int32_t& owner, float* vp, double* vt) {
     const auto ul = static_cast<std::size_t>(l);
     const Vec3 p = {grid_.origin[0] + (i + 0.5) * grid_.pitch[0], y_[ul], z_};
     auto accept = [&](const Vec3& t) {
       owner = cell;
       if (vt) std::copy(t.begin(), t.end(), vt);
     };
+    if (check_run > 0) {
+      Vec3 tc, rv;
+      if (chain.n > 0 && chain.predict(dom, tc) && loc_.check(cell, p, tc, vp, &rv)) {
+        accept(tc);
+        chain.push_checked(tc, rv, dom);
+        --check_run;
+        return;
+      }
+      check_run = 0;
+    }
     // Stepping from a fresh anchor at voxel (i, l).
     auto anchored = [&]() {
       Anchor a;
@@ -483,7 +590,7 @@ private:
       return true;
     };
     Vec3 t;
-    bool predicted = false;
+    bool predicted = false, far = false;
     if (cur >= 0) {
       t = anchors_[static_cast<std::size_t>(cur)].at(l, i);
       predicted = true;
@@ -499,16 +606,33 @@ private:
         if (d < bd) bd = d, best = k;
       }
       t = anchors_[best].at(l, i);
-      predicted = true;
+      predicted = far = true;
     }
     cur = -1;
-    if (predicted && loc_.expand(cell, t, exp_)) {
-      if (anchored()) return;
+    if (far) {
+      // Only a start for Newton: an anchor here would sit off the voxel's preimage.
+    } else if (predicted && loc_.expand(cell, t, exp_)) {
+      if (anchored()) {
+        // An anchor certifying little more than its own voxel sits on a boundary (a layer
+        // through a face between cells, say): residual checks are cheaper for the next voxels.
+        const Anchor& a = anchors_[static_cast<std::size_t>(cur)];
+        if (a.hi[ul] - i < 2) {
+          chain.set_jacobian(exp_.jac);
+          chain.push(a.at(l, i));
+          check_run = 16;
+        }
+        return;
+      }
       const Vec3 rv{p[0] - exp_.x[0], p[1] - exp_.x[1], p[2] - exp_.x[2]};
       if (rv[0] * rv[0] + rv[1] * rv[1] + rv[2] * rv[2] < tol_ * tol_) {
+        // Within the tolerance of the cell but nothing certified: on or near its boundary, as
+        // the next voxels probably are too (a layer through a face between cells, say). Cheap
+        // residual checks for a while before the next anchor.
         for (int h = 0; h < m_; ++h) vp[h] = static_cast<float>(exp_.props[static_cast<std::size_t>(h)]);
         accept(exp_.t);
+        chain.set_jacobian(exp_.jac);
         chain.push_checked(exp_.t, rv, dom);
+        check_run = 16;
         return;
       }
       t = exp_.t;
@@ -521,8 +645,7 @@ private:
       }
     }
     // The slow path: Newton, then the leaves.
-    c_slow++;
-    const Outcome o = solve_voxel(loc_, grid_, cell, i, p, predicted ? &t : nullptr, chain, t, lb, le, dom, out_->failures[ul]);
+    const Outcome o = solve_voxel(loc_, grid_, cell, i, p, predicted ? &t : nullptr, !far, chain, t, lb, le, dom, out_->failures[ul]);
     if (o == Outcome::outside) {
       std::fill(vp, vp + m_, 0.0f);  // an evaluation above may have written there
       cur = -1;
@@ -536,6 +659,7 @@ private:
   const Locator& loc_;
   const VoxelGrid& grid_;
   int m_;
+  FillRun fill_;
   BlockOut* out_ = nullptr;
   double tol_ = 0.0, z_ = 0.0;
   std::array<double, block_rows> y_{};

@@ -80,5 +80,6 @@ expect_fail "not a finite number" "$trivox" locate models/graded_block.json --xy
 expect_fail "not a finite number" "$trivox" locate models/graded_block.json --xyz 1,x,2
 expect_fail "no-such.json" "$trivox" locate no-such.json --xyz 1,2,3
 expect_fail "--tolerance" "$trivox" locate models/graded_block.json --xyz 1,2,3 --tolerance 0
+expect_fail "has no cells" "$trivox" locate models/gismo/teapot.xml --xyz 0,0,0
 expect_fail "" "$trivox" locate models/graded_block.json
 echo "cli locate: ok"

@@ -10,6 +10,7 @@
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/slice/locator.hpp"
+#include "trivox/spline/refine.hpp"
 
 using namespace trivox;
 using namespace trivox::test;
@@ -41,6 +42,10 @@ TEST_CASE("locate: a box cell, inside and outside") {
   }
   // On a face (within the tolerance) counts as inside.
   CHECK(loc.locate({4.0, 3, 4}).inside);
+  // Not a point at all: outside, flagged.
+  const auto nan = loc.locate({std::nan(""), 3, 4});
+  CHECK_FALSE(nan.inside);
+  CHECK_FALSE(nan.converged);
 }
 
 TEST_CASE("locate: rational quarter annulus agrees with the analytic inside test") {
@@ -155,4 +160,48 @@ TEST_CASE("locate: bad options and cells are reported") {
   const auto b = slice::model_bounds(model_of({box_cell({1, 2, 3}, {4, 5, 6}), box_cell({-1, 0, 0}, {0, 7, 1})}));
   CHECK(b[0] == Vec3{-1, 0, 0});
   CHECK(b[1] == Vec3{4, 7, 6});
+}
+
+TEST_CASE("locate: expansions equal the spline's first partials, and step bounds bound the second") {
+  // Two pieces per direction (an interior knot), so bounds are per piece and in global parameters.
+  auto cell = curved_tricubic();
+  for (int d = 0; d < 3; ++d) cell = spline::refine_uniform(cell, d, 1);
+  const auto m = model_of({cell}, {"r", "g", "b"});
+  const slice::Locator loc(m);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(0, 1);
+  const auto slots = spline::derivative_multi_indices<3>(2);
+  for (int n = 0; n < 500; ++n) {
+    const Vec3 t{U(rng), U(rng), U(rng)};
+    slice::Expansion e;
+    REQUIRE(loc.expand(0, t, e));
+    const auto d = cell.eval_derivatives(t, 2);  // 10 slots x 6 coordinates
+    for (int h = 0; h < 3; ++h) {
+      CHECK(e.x[static_cast<std::size_t>(h)] == Approx(d[static_cast<std::size_t>(h)]).margin(1e-12));
+      for (int k = 0; k < 3; ++k)
+        CHECK(e.jac[static_cast<std::size_t>(k)][static_cast<std::size_t>(h)] == Approx(d[static_cast<std::size_t>(6 * (1 + k) + h)]).margin(1e-9));
+    }
+    for (int h = 0; h < 3; ++h) {
+      CHECK(e.props[static_cast<std::size_t>(h)] == Approx(d[static_cast<std::size_t>(3 + h)]).margin(1e-12));
+      for (int k = 0; k < 3; ++k)
+        CHECK(e.grad[static_cast<std::size_t>(h)][static_cast<std::size_t>(k)] == Approx(d[static_cast<std::size_t>(6 * (1 + k) + 3 + h)]).margin(1e-9));
+    }
+    const auto& b = loc.step_bounds(e.piece);
+    REQUIRE(b.valid);
+    for (int dd = 0; dd < 3; ++dd) CHECK((t[static_cast<std::size_t>(dd)] >= b.lo[static_cast<std::size_t>(dd)] && t[static_cast<std::size_t>(dd)] <= b.hi[static_cast<std::size_t>(dd)]));
+    for (std::size_t s = 4; s < 10; ++s) {  // the second partials
+      const auto& a = slots[s];
+      int i = -1, j = -1;
+      for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < a[static_cast<std::size_t>(k)]; ++c) (i < 0 ? i : j) = k;
+      const double* v = &d[6 * s];
+      CHECK(std::hypot(v[0], v[1], v[2]) <= b.b2[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] * (1 + 1e-9));
+      for (int h = 3; h < 6; ++h) CHECK(std::abs(v[h]) <= b.p2[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] * (1 + 1e-9));
+    }
+  }
+  // Rational pieces have no expansion (their cells take the exact path).
+  const auto q = model_of({quarter_annulus(5, 10, 4)}, {"v"});
+  const slice::Locator lq(q);
+  slice::Expansion e;
+  CHECK_FALSE(lq.expand(0, {0.5, 0.5, 0.5}, e));
 }

@@ -7,12 +7,15 @@
 ///
 /// How: every cell is cut into its Bezier pieces (polynomial or rational, kept in Bernstein form
 /// for fast evaluation) and each piece is subdivided in parameter space into *leaves* until its
-/// control net is nearly affine (deviation below 10% of the leaf's size). A leaf's axis-aligned box
-/// of control points is conservative (convex hull property, also for positive weights). A
-/// bounding-volume hierarchy over the leaf boxes gives, for a point p, the candidate leaves; in
-/// each, point inversion is damped Newton on X(u,v,w) - p = 0 with the Jacobian from the first
-/// partials, clamped to the leaf's parameter box (projected Newton: coordinates pinned at a bound
-/// whose step points outwards are frozen and the others solved in the least-squares sense):
+/// control net is nearly affine: deviation from the least-squares affine map below 10% of the
+/// leaf's size and, with LocatorOptions::leaf_deviation, below that distance. Two conservative
+/// regions hold a leaf's image (convex hull property, also for positive weights): the
+/// axis-aligned box of its control points, and the parallelepiped of its control points in the
+/// frame of the affine map (tight for rotated or sheared leaves). A bounding-volume hierarchy over
+/// the leaf boxes gives, for a point p, the candidate leaves; in each whose regions hold p, point
+/// inversion is damped Newton on X(u,v,w) - p = 0 with the Jacobian from the first partials,
+/// clamped to the leaf's parameter box (projected Newton: coordinates pinned at a bound whose
+/// step points outwards are frozen and the others solved in the least-squares sense):
 /// - converged: |X(u,v,w) - p| < tolerance: p is in the cell at (u,v,w);
 /// - outside: stationary on the parameter box's boundary with the Newton step pointing outwards
 ///   and the first-order residual above the tolerance: p is not in this leaf (the leaf being
@@ -26,12 +29,19 @@
 /// along a row of voxels that converges in one or two evaluations, and the leaf search runs only
 /// when it does not.
 ///
+/// For the layer sampler the locator also exposes its building blocks: the leaves, Newton over a
+/// parameter box, an evaluation that checks a predicted (u,v,w), and for polynomial pieces an
+/// Expansion (value and first partials of every coordinate) with rigorous bounds on the second
+/// partials (StepBounds), from which the sampler certifies whole runs of voxels without
+/// evaluating them (sampler.hpp).
+///
 /// Overlapping cells: the first cell in file order that contains p wins (until Booleans define
 /// more). Points within the tolerance of a cell count as inside it.
 ///
 /// Cost: construction O(pieces * leaves per piece * order^3 * dim), parallel over cells (TBB).
 /// A query: a BVH descent plus, per candidate leaf, a few Newton iterations of O(order^3)
-/// (geometry only; properties cost one more O(order^3 * m) evaluation at the answer).
+/// (geometry only; properties cost one more O(order^3 * m) evaluation at the answer). Orders up
+/// to 16; kernels specialised for orders 2, 3 and 4 in all directions.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -65,7 +75,7 @@ struct LocatorOptions {
   int max_newton = 30;
   /// When > 0, leaves are also subdivided until their control nets deviate at most this much
   /// (model units) from an affine map, so their parallelepipeds hug the cell to within about this
-  /// distance (empty space skipped; the sampler uses 2 x its largest pitch). 0: only the
+  /// distance (empty space skipped; the sampler uses its largest pitch). 0: only the
   /// relative rule (10% of the leaf's size).
   double leaf_deviation = 0.0;
   /// Upper bound on the leaves of one Bezier piece (the most deviating are split first).
@@ -147,8 +157,14 @@ struct StepBounds {
   Vec3 lo{}, hi{};     ///< the piece's parameter box
   /// b2[d][e] >= |d^2 X / dt_d dt_e| (xyz, Euclidean norm) anywhere in the piece
   std::array<Vec3, 3> b2{};
+  /// b2v[d][e][k] >= |d^2 X_k / dt_d dt_e| per coordinate k: bounds that survive a linear map
+  /// (J^-1 applied to them), for affine-invariant certificates
+  std::array<std::array<Vec3, 3>, 3> b2v{};
   double lip = 0.0;    ///< max_d sqrt(sum_e b2[d][e]^2): |J(a) - J(b)|_F <= lip |a - b|_1
-  double p2 = 0.0;     ///< >= |d^2 P_h / dt_d dt_e| for every property h and d, e
+  /// p2[d][e] >= |d^2 P_h / dt_d dt_e| for every property h
+  std::array<Vec3, 3> p2{};
+  Vec3 slope{};                   ///< slope[d] >= |dX / dt_d| (xyz, Euclidean norm) in the piece
+  std::array<int, 3> degree{};    ///< polynomial degree per direction
 };
 
 /// An exact evaluation of a cell at t with the first partials of every coordinate: the anchor of
@@ -177,7 +193,7 @@ public:
 
   /// Which cell contains p and where; the first cell in file order wins on overlap.
   /// Thread-safe (const, no mutable state).
-  /// @param p     the point, xyz in model units
+  /// @param p     the point, xyz in model units (not finite: outside, with converged == false)
   /// @param hint  optional: a previous answer near p (same cell, its uvw) to warm-start Newton
   LocateResult locate(const Vec3& p, const LocateResult* hint = nullptr) const;
 

@@ -3,30 +3,49 @@
 /// the cell that contains its centre (or void) and the model's properties there.
 ///
 /// The print job's hot path (Masalha, Cirillo & Elber 2021, seed 000, Sec. 8: V-models sliced
-/// into Voxel Print images, geometry and materials together). Per image row (fixed y and z):
-/// - empty space is skipped: the row line meets only some leaves' xyz boxes (locator.hpp); each
-///   gives an x-interval, and voxels outside all intervals are void without any inversion;
-/// - within a cell's intervals, voxels are inverted in x order, each warm-started from its
-///   neighbours' (u,v,w) (quadratic extrapolation of the last three): damped Newton over the whole
-///   cell domain usually converges in one evaluation;
-/// - only when that does not converge (entering the cell, leaving it, the first voxel of a run),
-///   the leaves whose intervals hold the voxel decide, by Newton clamped to each leaf (each
-///   warm-started from its own answer at the previous voxel) with the locator's subdivision
-///   fallback. So occupancy is as exact as Locator::locate.
-/// Cells are processed in file order and a voxel taken by a cell is skipped by later ones: the
-/// first cell wins on overlap. Properties are the cell's coordinates 3.. evaluated at the located
-/// (u,v,w) (exact up to rounding to float).
+/// into Voxel Print images, geometry and materials together; their research code took about six
+/// minutes for a 1516 x 2524 slice). A layer is processed in blocks of 4 image rows, cell by cell
+/// in file order (a voxel taken by a cell is skipped by later ones: the first cell wins on
+/// overlap), each row from left to right:
+/// - Empty space is skipped: a row line meets only some leaves' regions (locator.hpp; the
+///   sampler asks for leaves within about one voxel of affine), each gives an x-interval, and
+///   voxels outside every interval are void without any inversion.
+/// - Certified stepping (polynomial cells with up to 7 properties): an *anchor* is one exact
+///   evaluation at a voxel, of every coordinate with its first partials (Locator::expand). From
+///   it the parameters of the voxels around it follow from the linear model,
+///   t = t0 + J0^-1 (p - X0), and their properties from P0 + G0 (t - t0). The piece's bounds on
+///   second partials (StepBounds) turn that into a certificate: a Taylor bound on
+///   |J0^-1 (X(t) - p)|, the Newton-Kantorovich theorem in its affine-covariant form (Deuflhard;
+///   so thin, sheared or layer-thin cells are as well served as cubes) for an exact preimage t*
+///   within a radius r of t inside the piece (so p is inside the cell; or outside the piece by
+///   less than the tolerance, where the contract allows either answer: a layer through a face
+///   between cells is certified too), and a bound on |model - P(t*)| below 0.95/512. All bounds
+///   grow with the distance from the anchor, so an anchor certifies a rectangle of voxels across
+///   the block's rows at once (found by doubling and bisection on its width); inside it a voxel
+///   costs a few multiply-adds.
+/// - Elsewhere (near boundaries, rational cells): the voxel is evaluated once at a prediction
+///   (a new anchor, or an exact residual check |X(t) - p| < tolerance), and failing that Newton
+///   over the cell domain from the prediction, then the leaves whose intervals hold the voxel
+///   (Newton clamped to each leaf, warm-started from its answer at the previous voxel, with the
+///   locator's subdivision fallback) decide. So occupancy is as exact as Locator::locate.
 ///
-/// Accuracy: occupancy equals the exact answer except for voxel centres within the tolerance
-/// (1e-3 of the smallest pitch) of a cell boundary; properties are those at a (u,v,w) whose image
-/// lies within that tolerance of the centre.
+/// Accuracy (tests check it against a locator at tolerance 1e-10): occupancy equals the exact
+/// answer except for voxel centres within the tolerance (1e-3 of the smallest pitch) of a cell
+/// boundary; properties are within 1/512 of the cell's properties at the exact preimage of the
+/// voxel's centre (certified voxels: by the bound above; evaluated voxels: exact at a (u,v,w)
+/// whose image lies within the tolerance of the centre). The (u,v,w) kept with
+/// SamplerOptions::keep_uvw map within the tolerance of the centre for evaluated voxels and within
+/// half the smallest pitch for certified ones (their exact preimage being within the certified
+/// radius).
 ///
-/// Determinism: a row's result depends only on the row (layer, image row), never on the band it
-/// was computed in or on other threads, so any banding and thread count give identical output.
+/// Determinism: a block's result depends only on the block (layer and its 4 image rows); a band
+/// computes every block it touches in full and copies out its rows, so any banding and thread
+/// count give identical output.
 ///
-/// Cost: per voxel inside the model about one geometry evaluation (O(order^3)) plus one property
-/// evaluation (O(order^3 * m)); per row a pass over the leaves that meet the layer; void voxels
-/// outside every leaf box cost nothing. No allocation per voxel.
+/// Cost: per voxel inside a cell a few multiply-adds where certified, about one evaluation
+/// (O(order^3 * (3 + m))) per anchor (tens of voxels each at printer pitch), a few Newton
+/// iterations per voxel near boundaries; per row a pass over the leaves that meet the block;
+/// void voxels outside every leaf region cost nothing. No allocation per voxel.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -49,7 +68,9 @@ struct RowBand {
   /// inside (at the best iterate) when that iterate's image lies within half the smallest pitch of
   /// the centre, else void. Reported in the job summary and manifest, never silent.
   std::int64_t failures = 0;
-  std::int64_t inverted = 0;  ///< voxels that needed Newton (inside some leaf box): a cost figure
+  /// Voxels inside some leaf's region of a cell that had not taken them yet (stepped, evaluated
+  /// or inverted): a cost figure.
+  std::int64_t inverted = 0;
   /// rows * nx * 3: the located (u,v,w) of each voxel (0 for void); only with
   /// SamplerOptions::keep_uvw, else empty.
   std::vector<double> uvw;
@@ -69,6 +90,10 @@ struct SamplerOptions {
 
 class LayerSampler {
 public:
+  /// Image rows sampled together (blocks aligned on multiples of this): bands whose first row
+  /// and size are multiples of it cost no recomputation.
+  static constexpr int block_rows = 4;
+
   /// @param model  the V-model; must outlive the sampler and stay unchanged
   /// @param grid   the voxel grid (copied); the locator's tolerance is 1e-3 * its smallest pitch
   /// @param opt    sampling options
