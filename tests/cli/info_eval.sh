@@ -48,16 +48,7 @@ PY
 "$trivox" eval models/gismo/cube.xml --cell patch0 --uvw 0.5,0.5,0.5 | grep -q "point: (0.5, 0.5, 0.5)"
 
 # Bad input: exit 2 and a message naming the file, the place and what was expected.
-expect_fail() {  # expect_fail PATTERN command...
-  local pattern=$1; shift
-  set +e
-  "$@" > "$tmp/out" 2> "$tmp/err"
-  local rc=$?
-  set -e
-  if [ $rc -ne 2 ]; then echo "expected exit 2, got $rc: $*"; cat "$tmp/err"; exit 1; fi
-  if ! grep -q -- "$pattern" "$tmp/err"; then echo "message lacks '$pattern': $*"; cat "$tmp/err"; exit 1; fi
-  if [ -s "$tmp/out" ]; then echo "unexpected stdout: $*"; exit 1; fi
-}
+source "$(dirname "$0")/lib.bash"
 expect_fail "no-such.json" "$trivox" info no-such.json
 expect_fail "expected" "$trivox" info models
 printf '{"trivox": 1, "cells": [' > "$tmp/trunc.json"

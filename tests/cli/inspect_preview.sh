@@ -138,16 +138,7 @@ set -e
 [ $rc -eq 1 ] && grep -q "VoxelCount mismatch" "$tmp/err"
 
 # Bad input: exit 2, a message naming the file, the place and what was expected; no stdout.
-expect_fail() {  # expect_fail PATTERN command...
-  local pattern=$1; shift
-  set +e
-  "$@" > "$tmp/out" 2> "$tmp/err"
-  local rc=$?
-  set -e
-  if [ $rc -ne 2 ]; then echo "expected exit 2, got $rc: $*"; cat "$tmp/err"; exit 1; fi
-  if ! grep -q -- "$pattern" "$tmp/err"; then echo "message lacks '$pattern': $*"; cat "$tmp/err"; exit 1; fi
-  if [ -s "$tmp/out" ]; then echo "unexpected stdout: $*"; exit 1; fi
-}
+source "$(dirname "$0")/lib.bash"
 mkdir "$tmp/empty"
 expect_fail "no ConfigFile.xml; expected a slice folder" "$trivox" inspect "$tmp/empty"
 expect_fail "no such folder" "$trivox" inspect "$tmp/nothing"

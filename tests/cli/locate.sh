@@ -65,16 +65,7 @@ PY
 "$trivox" locate models/graded_block.json --xyz 100,10,5 | grep -q "outside every cell"
 
 # Bad input: exit 2 and a message naming what was expected; nothing on stdout.
-expect_fail() {  # expect_fail PATTERN command...
-  local pattern=$1; shift
-  set +e
-  "$@" > "$tmp/out" 2> "$tmp/err"
-  local rc=$?
-  set -e
-  if [ $rc -ne 2 ]; then echo "expected exit 2, got $rc: $*"; cat "$tmp/err"; exit 1; fi
-  if ! grep -q -- "$pattern" "$tmp/err"; then echo "message lacks '$pattern': $*"; cat "$tmp/err"; exit 1; fi
-  if [ -s "$tmp/out" ]; then echo "unexpected stdout: $*"; exit 1; fi
-}
+source "$(dirname "$0")/lib.bash"
 expect_fail "expected 3 comma-separated numbers" "$trivox" locate models/graded_block.json --xyz 1,2
 expect_fail "not a finite number" "$trivox" locate models/graded_block.json --xyz 1,inf,2
 expect_fail "not a finite number" "$trivox" locate models/graded_block.json --xyz 1,x,2

@@ -58,15 +58,7 @@ assert summary["filled"] == 448 and summary["inversion_failures"] == 0, summary
 PY
 
 # Refusals: exit 2 with the reason.
-expect_fail() {
-  local pattern=$1; shift
-  set +e
-  "$@" > "$tmp/out" 2> "$tmp/err"
-  local rc=$?
-  set -e
-  if [ $rc -ne 2 ]; then echo "expected exit 2, got $rc: $*"; cat "$tmp/err"; exit 1; fi
-  grep -q -- "$pattern" "$tmp/err" || { echo "message lacks '$pattern': $*"; cat "$tmp/err"; exit 1; }
-}
+source "$(dirname "$0")/lib.bash"
 expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never
 expect_fail "unknown printer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --printer j9000
 expect_fail "expected 10 to 10000" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x2" --dpi 0,100
