@@ -8,6 +8,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "../detail/json_text.hpp"
+
 #include "trivox/error.hpp"
 
 namespace trivox::io {
@@ -46,33 +48,13 @@ std::string format_double(double v) {
   return s;
 }
 
-/// A JSON string literal, ASCII only so that a message never carries broken UTF-8.
-std::string quote(const std::string& s) {
-  return json(s).dump(-1, ' ', true, json::error_handler_t::replace);
-}
+std::string quote(const std::string& s) { return detail::json_quote(s); }
 
 std::string plural(std::int64_t n, const std::string& word) {
   return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
 }
 
-/// What a value is, for "found ...; expected ..." messages.
-std::string describe(const json& j) {
-  switch (j.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return j.get<bool>() ? "true" : "false";
-    case json::value_t::string: {
-      std::string s = quote(j.get<std::string>());
-      if (s.size() > 40) s = s.substr(0, 36) + "...\"";
-      return "the string " + s;
-    }
-    case json::value_t::number_integer:
-    case json::value_t::number_unsigned:
-    case json::value_t::number_float: return "the number " + j.dump();
-    case json::value_t::array: return "an array of " + std::to_string(j.size());
-    case json::value_t::object: return "an object";
-    default: return "a binary value";
-  }
-}
+std::string describe(const json& j) { return detail::json_describe(j); }
 
 [[noreturn]] void fail_type(const Source& src, const std::string& ptr, const json& j,
                             const std::string& expected) {

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <fstream>
 #include <nlohmann/json.hpp>
+
+#include "../detail/json_text.hpp"
 #include <sstream>
 
 #include "trivox/error.hpp"
@@ -23,27 +25,9 @@ constexpr const char* name_rule =
 // ------------------------------------------------------------------------------------------
 // Messages: "<file>: <JSON pointer>: found ...; expected ..."
 
-std::string quote(const std::string& s) {
-  return json(s).dump(-1, ' ', true, json::error_handler_t::replace);
-}
+std::string quote(const std::string& s) { return detail::json_quote(s); }
 
-std::string describe(const json& j) {
-  switch (j.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return j.get<bool>() ? "true" : "false";
-    case json::value_t::string: {
-      std::string s = quote(j.get<std::string>());
-      if (s.size() > 40) s = s.substr(0, 36) + "...\"";
-      return "the string " + s;
-    }
-    case json::value_t::number_integer:
-    case json::value_t::number_unsigned:
-    case json::value_t::number_float: return "the number " + j.dump();
-    case json::value_t::array: return "an array of " + std::to_string(j.size());
-    case json::value_t::object: return "an object";
-    default: return "a binary value";
-  }
-}
+std::string describe(const json& j) { return detail::json_describe(j); }
 
 struct Source {
   const std::string& name;
