@@ -90,57 +90,14 @@ private:
   std::string message_;
 };
 
-/// "line L, column C" of the character nlohmann read last before failing (position counts the
-/// characters read, so the culprit is at position - 1).
-std::string line_column(std::string_view text, std::size_t position) {
-  const std::size_t at = std::min(position > 0 ? position - 1 : 0, text.size());
-  std::size_t line = 1, line_start = 0;
-  for (std::size_t i = 0; i < at; ++i)
-    if (text[i] == '\n') ++line, line_start = i + 1;
-  return "line " + std::to_string(line) + ", column " + std::to_string(at - line_start + 1);
-}
-
-/// Keeps the end of nlohmann's "last read: '<token>'" short and ASCII: an unterminated string
-/// would otherwise put the rest of the file, with any invalid bytes, into the message.
-std::string shorten_last_read(std::string what) {
-  const std::string open = "last read: '";
-  const auto begin = what.find(open);
-  if (begin == std::string::npos) return what;
-  const auto from = begin + open.size();
-  auto to = what.rfind("'; expected");
-  if (to == std::string::npos || to < from) to = what.rfind('\'');
-  if (to == std::string::npos || to < from) return what;
-  std::string token = what.substr(from, to - from);
-  if (token.size() > 40) token = "..." + token.substr(token.size() - 37);
-  for (char& c : token)
-    if (static_cast<unsigned char>(c) >= 0x7f || static_cast<unsigned char>(c) < 0x20) c = '?';
-  return what.substr(0, from) + token + what.substr(to);
-}
-
-/// nlohmann's message without its "[json.exception...] parse error at line L, column C: " prefix
-/// (we give our own position), ending with what was expected.
-std::string parse_message(std::string what) {
-  what = shorten_last_read(std::move(what));
-  if (what.starts_with("[json.exception.")) {
-    if (const auto p = what.find("] "); p != std::string::npos) what.erase(0, p + 2);
-  }
-  if (what.starts_with("parse error")) {
-    if (const auto p = what.find(": "); p != std::string::npos) what.erase(0, p + 2);
-  }
-  if (what.find("number overflow") != std::string::npos)
-    return what + "; expected a finite number (magnitude below 1.8e308)";
-  if (what.find("expected") == std::string::npos) what += "; expected well-formed JSON";
-  return what;
-}
-
 json parse(const Source& src, std::string_view text) {
   json root;
   PositionedParser parser(root);
   json::sax_parse(text.begin(), text.end(), &parser, nlohmann::detail::input_format_t::json,
                   /*strict=*/true, /*ignore_comments=*/false);
   if (parser.failed())
-    throw Error(src.name + ": " + line_column(text, parser.position()) +
-                ": malformed JSON: " + parse_message(parser.message()));
+    throw Error(src.name + ": " + detail::json_line_column(text, parser.position()) +
+                ": malformed JSON: " + detail::json_parse_message(parser.message()));
   return root;
 }
 

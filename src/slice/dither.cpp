@@ -39,7 +39,9 @@ struct FsRow {
   const float* fractions;
   std::uint8_t* out;
   float* in;       // incoming error of this row: (nx + 2) * stride, one pad voxel each side
-  float* down;     // error for the next row, same layout, all zero on entry
+  float* down;     // error for the next row, same layout: overwritten by the kernels for up to
+                   // 8 materials; accumulated into (zero on entry) by the runtime-count kernel,
+                   // which zeroes `in` as it reads it so that the halves can swap
   float* scratch;  // 2 * stride, for the runtime-count kernel
 };
 
@@ -86,13 +88,26 @@ void fs_kernel(const FsRow& a) {
   const float(*const weights)[4] = a.weights;
   const int nx = a.nx, dir = a.left_to_right ? 1 : -1;
   int x = a.left_to_right ? 0 : nx - 1;
-  float* in = a.in + S;  // skip the pad: in + x * S is voxel x
+  const float* in = a.in + S;  // skip the pad: in + x * S is voxel x
   float* down = a.down + S;
+  // The next row's error at x - dir, x and x + dir is complete once voxel x + dir... is done:
+  // down[x - dir] receives from x - 2 dir, x - dir and x, in that order. So it is summed in
+  // registers (here: down[x], fwd: down[x + dir]) and stored once, final, in the same order of
+  // additions as accumulating in memory would use; every voxel and both pads get stored, so
+  // `down` needs no clearing and `in` is only read.
+  V4 acc_here[NV], acc_fwd[NV];
+  for (int i = 0; i < NV; ++i) acc_here[i] = acc_fwd[i] = V4{};
   for (int t = 0; t < nx; ++t, x += dir) {
-    float* e = in + static_cast<std::ptrdiff_t>(x) * S;
+    const float* e = in + static_cast<std::ptrdiff_t>(x) * S;
+    float* d_back = down + static_cast<std::ptrdiff_t>(x - dir) * S;
     if (cell[x] < 0) {  // void: the error aimed here is dropped, none leaves
       out[x] = void_material;
-      for (int i = 0; i < NV; ++i) store(e + 4 * i, V4{}), carry[i] = V4{};
+      for (int i = 0; i < NV; ++i) {
+        store(d_back + 4 * i, acc_here[i]);
+        acc_here[i] = acc_fwd[i];
+        acc_fwd[i] = V4{};
+        carry[i] = V4{};
+      }
       continue;
     }
     V4 f[NV];
@@ -105,7 +120,6 @@ void fs_kernel(const FsRow& a) {
     V4 v[NV], masked[NV];
     for (int i = 0; i < NV; ++i) {
       const V4 base = f[i] + load(e + 4 * i);
-      store(e + 4 * i, V4{});
       const V4 penalised = base + (f[i] > 0.0f ? V4{} : none);
       v[i] = base + carry[i];
       masked[i] = penalised + carry[i];
@@ -137,16 +151,18 @@ void fs_kernel(const FsRow& a) {
                      (!last ? has_down_forward : 0);
     const float* w = weights[mask];
     // Unavailable neighbours have weight 0, and the pads absorb the edge writes.
-    float* d_back = down + static_cast<std::ptrdiff_t>(x - dir) * S;
-    float* d_here = down + static_cast<std::ptrdiff_t>(x) * S;
-    float* d_fwd = down + static_cast<std::ptrdiff_t>(x + dir) * S;
     for (int i = 0; i < NV; ++i) {
       const V4 err = v[i] - hit[i];
       carry[i] = w[0] * err;
-      store(d_back + 4 * i, load(d_back + 4 * i) + w[1] * err);
-      store(d_here + 4 * i, load(d_here + 4 * i) + w[2] * err);
-      store(d_fwd + 4 * i, load(d_fwd + 4 * i) + w[3] * err);
+      store(d_back + 4 * i, acc_here[i] + w[1] * err);
+      acc_here[i] = acc_fwd[i] + w[2] * err;
+      acc_fwd[i] = w[3] * err;
     }
+  }
+  // x is one past the last voxel: flush down[x - dir] (the last voxel) and down[x] (a pad).
+  for (int i = 0; i < NV; ++i) {
+    store(down + static_cast<std::ptrdiff_t>(x - dir) * S + 4 * i, acc_here[i]);
+    store(down + static_cast<std::ptrdiff_t>(x) * S + 4 * i, acc_fwd[i]);
   }
 }
 

@@ -374,7 +374,11 @@ struct Locator::Data {
     std::size_t net = 0;  ///< offset into the pool
     Vec3 lipschitz{};     ///< bounds on |dX/dt_d| (global parameters); inf if rational
     StepBounds bounds;    ///< second-derivative bounds (polynomial pieces with all_first)
+    /// Tighter bounds near a point: the piece cut into local_div^3 sub-boxes, and for each the
+    /// bounds over it and its neighbours (up to 3 x 3 x 3 sub-boxes); empty without `bounds`.
+    std::vector<StepBounds> local;
   };
+  static constexpr int local_div = 8;
   struct Cell {
     std::array<std::vector<double>, 3> breaks;  ///< distinct knots inside the domain
     std::array<int, 3> spans{};
@@ -601,6 +605,39 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
   return b;
 }
 
+/// Hodograph bound: |dX/dt_d| <= (order - 1) max |P_{i+1} - P_i| / len (polynomial nets with
+/// `stride` coordinates per point, xyz first).
+Vec3 hodograph_bounds(const std::vector<double>& net, const Data::Piece& pc, int stride) {
+  Vec3 out{};
+  const int n = pc.order[0] * pc.order[1] * pc.order[2];
+  for (int d = 0; d < 3; ++d) {
+    const auto dd = static_cast<std::size_t>(d);
+    if (pc.order[dd] < 2) continue;
+    const int step = d == 0 ? 1 : d == 1 ? pc.order[0] : pc.order[0] * pc.order[1];
+    double mx = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const int idx = d == 0 ? i % pc.order[0] : d == 1 ? (i / pc.order[0]) % pc.order[1] : i / (pc.order[0] * pc.order[1]);
+      if (idx + 1 >= pc.order[dd]) continue;
+      double diff[3];
+      for (int h = 0; h < 3; ++h)
+        diff[h] = net[static_cast<std::size_t>((i + step) * stride + h)] - net[static_cast<std::size_t>(i * stride + h)];
+      mx = std::max(mx, norm3(diff));
+    }
+    // The same 1e-12 relative slack as the second-derivative bounds, for rounding.
+    out[dd] = (pc.order[dd] - 1) * mx * pc.inv_len[dd] * (1.0 + 1e-12);
+  }
+  return out;
+}
+
+/// Everything the sampler's certificates need of a polynomial piece (or part of one: `pc` gives
+/// the parameter box of `net`, nc = 3 + m coordinates per point).
+StepBounds step_bounds_of(const std::vector<double>& net, const Data::Piece& pc, int m) {
+  StepBounds b = second_derivative_bounds(net, pc, m);
+  b.slope = hodograph_bounds(net, pc, pc.nc);
+  for (std::size_t d = 0; d < 3; ++d) b.degree[d] = pc.order[d] - 1;
+  return b;
+}
+
 CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const LocatorOptions& opt) {
   const auto& s = vc.volume;
   CellBuild cb;
@@ -641,28 +678,27 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
       for (int h = 0; h < H; ++h) all[static_cast<std::size_t>(i * pc.nc + h)] = g[static_cast<std::size_t>(i * H + h)];
       for (int h = 0; h < m; ++h) all[static_cast<std::size_t>(i * pc.nc + H + h)] = w * q[static_cast<std::size_t>(3 + h)];
     }
-    // Hodograph bound: |dX/dt_d| <= (order - 1) max |P_{i+1} - P_i| / len (polynomial only).
-    for (int d = 0; d < 3; ++d) {
-      const auto dd = static_cast<std::size_t>(d);
-      if (H == 4 || pc.order[dd] < 2) {
-        pc.lipschitz[dd] = H == 4 ? inf : 0.0;
-        continue;
-      }
-      const int step = d == 0 ? 1 : d == 1 ? pc.order[0] : pc.order[0] * pc.order[1];
-      double mx = 0.0;
-      for (int i = 0; i < n; ++i) {
-        const int idx = d == 0 ? i % pc.order[0] : d == 1 ? (i / pc.order[0]) % pc.order[1] : i / (pc.order[0] * pc.order[1]);
-        if (idx + 1 >= pc.order[dd]) continue;
-        double diff[3];
-        for (int h = 0; h < 3; ++h) diff[h] = g[static_cast<std::size_t>((i + step) * H + h)] - g[static_cast<std::size_t>(i * H + h)];
-        mx = std::max(mx, norm3(diff));
-      }
-      pc.lipschitz[dd] = (pc.order[dd] - 1) * mx * pc.inv_len[dd];
-    }
+    pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g, pc, H);
     if (pc.k.all_first) {
-      pc.bounds = second_derivative_bounds(all, pc, m);
-      pc.bounds.slope = pc.lipschitz;
-      for (std::size_t d = 0; d < 3; ++d) pc.bounds.degree[d] = pc.order[d] - 1;
+      pc.bounds = step_bounds_of(all, pc, m);
+      pc.local.resize(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
+      constexpr double S = Data::local_div;
+      for (int c = 0; c < Data::local_div; ++c)
+        for (int b = 0; b < Data::local_div; ++b)
+          for (int a = 0; a < Data::local_div; ++a) {
+            const int idx[3] = {a, b, c};
+            Vec3 lo, hi;
+            Data::Piece sub = pc;
+            for (std::size_t d = 0; d < 3; ++d) {
+              lo[d] = std::max(0.0, (idx[d] - 1) / S);
+              hi[d] = std::min(1.0, (idx[d] + 2) / S);
+              sub.lo[d] = pc.lo[d] + lo[d] * pc.len[d];
+              sub.len[d] = (hi[d] - lo[d]) * pc.len[d];
+              sub.inv_len[d] = 1.0 / sub.len[d];
+            }
+            pc.local[static_cast<std::size_t>(a + Data::local_div * (b + Data::local_div * c))] =
+                step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi), sub, m);
+          }
     }
     std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
     build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.max_leaves_per_piece, lv);
@@ -886,6 +922,16 @@ bool Locator::expand(int cell, const Vec3& t, Expansion& out) const {
 }
 
 const StepBounds& Locator::step_bounds(int piece) const noexcept { return data_->pieces[static_cast<std::size_t>(piece)].bounds; }
+
+const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
+  const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
+  if (pc.local.empty()) return pc.bounds;
+  double s[3];
+  Data::local(pc, t, s);
+  int idx[3];
+  for (int d = 0; d < 3; ++d) idx[d] = std::min(Data::local_div - 1, static_cast<int>(s[d] * Data::local_div));
+  return pc.local[static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]))];
+}
 
 namespace {
 /// A converged answer, with one more Newton step (not evaluated) as the warm start for neighbours:

@@ -40,54 +40,7 @@ struct Source {
   }
 };
 
-std::string line_column(std::string_view text, std::size_t byte) {
-  const std::size_t at = std::min(byte > 0 ? byte - 1 : 0, text.size());
-  std::size_t line = 1, line_start = 0;
-  for (std::size_t i = 0; i < at; ++i)
-    if (text[i] == '\n') ++line, line_start = i + 1;
-  return "line " + std::to_string(line) + ", column " + std::to_string(at - line_start + 1);
-}
-
-/// nlohmann's message without its "[json.exception...] parse error at ...: " prefix, short and
-/// ASCII (an unterminated string would otherwise quote the rest of the file).
-std::string parse_message(std::string what) {
-  if (what.starts_with("[json.exception."))
-    if (const auto p = what.find("] "); p != std::string::npos) what.erase(0, p + 2);
-  if (what.starts_with("parse error"))
-    if (const auto p = what.find(": "); p != std::string::npos) what.erase(0, p + 2);
-  if (const auto p = what.find("last read: '"); p != std::string::npos) {
-    const auto from = p + 12;
-    auto to = what.rfind('\'');
-    if (to == std::string::npos || to < from) to = what.size();
-    std::string token = what.substr(from, to - from);
-    if (token.size() > 40) token = "..." + token.substr(token.size() - 37);
-    for (char& c : token)
-      if (static_cast<unsigned char>(c) >= 0x7f || static_cast<unsigned char>(c) < 0x20) c = '?';
-    what = what.substr(0, from) + token + (to < what.size() ? what.substr(to) : std::string("'"));
-  }
-  if (what.find("number overflow") != std::string::npos)
-    return what + "; expected a finite number";
-  if (what.find("expected") == std::string::npos) what += "; expected well-formed JSON";
-  return what;
-}
-
-json parse_json(const Source& src, std::string_view text) {
-  try {
-    return json::parse(text.begin(), text.end());
-  } catch (const json::parse_error& e) {
-    throw Error(src.name + ": " + line_column(text, e.byte) + ": malformed JSON: " + parse_message(e.what()));
-  } catch (const json::exception& e) {
-    // A number overflow (1e999) comes without a position: find the quoted token.
-    std::string where;
-    const std::string what = e.what();
-    if (const auto q = what.find("parsing '"); q != std::string::npos) {
-      const auto end = what.find('\'', q + 9);
-      const auto at = text.find(what.substr(q + 9, end - (q + 9)));
-      if (end != std::string::npos && at != std::string_view::npos) where = line_column(text, at + 1) + ": ";
-    }
-    throw Error(src.name + ": " + where + "malformed JSON: " + parse_message(what));
-  }
-}
+json parse_json(const Source& src, std::string_view text) { return detail::parse_json_text(text, src.name); }
 
 bool valid_name(const std::string& s) {
   if (s.empty() || s.size() > max_name_length || s.front() == ' ' || s.back() == ' ') return false;
@@ -179,7 +132,7 @@ int material_named(const Source& src, const Palette& p, const json& j, const std
 
 /// The r, g, b conversion's C, M, Y, K, W with m = max(r, g, b) (the derivation is in
 /// docs/materials.md); the clamp also turns NaN into 0.
-inline void cmykw(float r, float g, float b, float* f) noexcept {
+[[gnu::always_inline]] inline void cmykw(float r, float g, float b, float* f) noexcept {
   r = r > 0.0f ? (r < 1.0f ? r : 1.0f) : 0.0f;
   g = g > 0.0f ? (g < 1.0f ? g : 1.0f) : 0.0f;
   b = b > 0.0f ? (b < 1.0f ? b : 1.0f) : 0.0f;
@@ -403,6 +356,37 @@ void MaterialMapper::fractions(const float* props, float* out) const noexcept {
 void MaterialMapper::fractions(const float* props, std::size_t count, float* out) const noexcept {
   const auto np = static_cast<std::size_t>(properties_), nm = static_cast<std::size_t>(materials_);
   for (std::size_t v = 0; v < count; ++v) fractions(props + v * np, out + v * nm);
+}
+
+void MaterialMapper::fractions(const float* props, const std::int32_t* cell, std::size_t count,
+                               float* out) const noexcept {
+  const auto np = static_cast<std::size_t>(properties_), nm = static_cast<std::size_t>(materials_);
+  if (rgb_ && explicit_.empty()) {
+    // Colour only: the same as fractions() per voxel (rest = 1, nothing to add to), inlined.
+    const std::size_t ir = static_cast<std::size_t>(rgb_props_[0]), ig = static_cast<std::size_t>(rgb_props_[1]),
+                      ib = static_cast<std::size_t>(rgb_props_[2]);
+    auto run = [&]<std::size_t NM>() {
+      const std::size_t n = NM > 0 ? NM : nm;
+      for (std::size_t v = 0; v < count; ++v) {
+        if (cell[v] < 0) continue;
+        const float* p = props + v * np;
+        float* o = out + v * n;
+        float f[5];
+        cmykw(p[ir], p[ig], p[ib], f);
+        for (std::size_t k = 0; k < n; ++k) o[k] = 0.0f;
+        for (std::size_t k = 0; k < 5; ++k) o[cmykw_[k]] = f[k];
+      }
+    };
+    // The palette's size as a constant for the common ones: no memset call per voxel.
+    if (nm == 5) run.operator()<5>();
+    else if (nm == 6) run.operator()<6>();
+    else if (nm == 7) run.operator()<7>();
+    else if (nm == 8) run.operator()<8>();
+    else run.operator()<0>();
+    return;
+  }
+  for (std::size_t v = 0; v < count; ++v)
+    if (cell[v] >= 0) fractions(props + v * np, out + v * nm);
 }
 
 std::string MaterialMapper::describe() const { return describe_; }

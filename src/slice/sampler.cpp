@@ -106,7 +106,7 @@ public:
   /// the voxel itself) is certified.
   bool make(const Expansion& e, int i, int l, const Vec3& p, Anchor& a) {
     std::array<Vec3, 3> inv;
-    b_ = &loc_.step_bounds(e.piece);
+    b_ = &loc_.step_bounds(e.piece, e.t);
     if (!b_->valid || !invert(e.jac, inv)) return false;
     e_ = &e;
     c0_ = mul(inv, {p[0] - e.x[0], p[1] - e.x[1], p[2] - e.x[2]});
@@ -211,9 +211,13 @@ private:
   /// Whether every voxel (ia + k, la + l), -kn <= k <= kp, -ln <= l <= lp, is certified.
   /// Newton-Kantorovich for G(t) = J0^-1 (X(t) - p) from the voxel's linear-model parameters t
   /// (d = t - t0, |d_j| <= a_j): |G(t)| <= eta = 1/2 sum w_de a_d a_e (Taylor); G' = J0^-1 J moves
-  /// by at most omega |d|_1 <= 1/2 from the identity, so |G'(t)^-1| <= 2; G' is Lipschitz with
-  /// sqrt3 omega in the 2-norm; then h = 2 (sqrt3 omega) 2 eta <= 1/2 puts the root within
-  /// r = 2 (2 eta) of t.
+  /// by at most theta = omega |d|_1 <= 1/2 from the identity, so |G'(t)^-1| <= beta = 1/(1 - theta)
+  /// (Neumann series); G' is Lipschitz with L = sqrt3 omega in the 2-norm; then Kantorovich's
+  /// h = beta^2 L eta <= 1/2 puts the root within r = (1 - sqrt(1 - 2h)) / (beta L)
+  /// = 2 beta eta / (1 + sqrt(1 - 2h)) of t (about eta when h is small, 4 eta at worst).
+  /// The bounds are those of the part of the piece around the anchor (Locator::step_bounds(piece,
+  /// t)); leaving that part is handled like leaving the piece (see below), which stays valid
+  /// because the part lies inside the cell.
   bool certified(int kn, int kp, int ln, int lp) const {
     // Bounds hold in the piece's box; where the certificate reaches out of it (a voxel on or
     // next to a face) they are retried with every bound scaled by 1.01, valid as long as the
@@ -230,15 +234,19 @@ private:
                  std::abs(c0_[2]) + K * std::abs(dx_[2]) + L * std::abs(dy_[2])};
     const double s1 = a[0] + a[1] + a[2];
     const double omega = G * omega_;
-    if (!(omega * s1 <= 0.5)) return 0;
+    const double theta = omega * s1;
+    if (!(theta <= 0.5)) return 0;
     const auto& B = b_->b2;
     const double e2 = G * (0.5 * (B[0][0] * a[0] * a[0] + B[1][1] * a[1] * a[1] + B[2][2] * a[2] * a[2]) +
                            B[0][1] * a[0] * a[1] + B[0][2] * a[0] * a[2] + B[1][2] * a[1] * a[2]);
     if (!(e2 <= max_residual_)) return 0;  // keeps the (u,v,w) reported meaningful
     const double eta = G * (0.5 * (w_[0][0] * a[0] * a[0] + w_[1][1] * a[1] * a[1] + w_[2][2] * a[2] * a[2]) +
                             w_[0][1] * a[0] * a[1] + w_[0][2] * a[0] * a[2] + w_[1][2] * a[1] * a[2]);
-    if (!(4.0 * sqrt3 * omega * eta <= 0.5)) return 0;
-    const double R = 4.0 * eta;
+    const double beta = 1.0 / (1.0 - theta);  // |G'(t)^-1| <= 1 / (1 - |G'(t) - I|)
+    const double h = beta * beta * sqrt3 * omega * eta;
+    if (!(h <= 0.5)) return 0;
+    // Kantorovich: the root lies within (1 - sqrt(1 - 2h)) / (beta L) = 2 beta eta / (1 + sqrt(1 - 2h)).
+    const double R = 2.0 * beta * eta / (1.0 + std::sqrt(1.0 - 2.0 * h));
     const Vec3 r{R, R, R};
     // How far the parameters and the ball around them leave the piece's box, per direction.
     // Leaving it by delta puts the root t* of the piece's polynomial up to delta outside, where

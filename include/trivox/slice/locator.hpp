@@ -238,6 +238,9 @@ public:
   bool expand(int cell, const Vec3& t, Expansion& out) const;
   /// The second-derivative bounds of a piece (Expansion::piece).
   const StepBounds& step_bounds(int piece) const noexcept;
+  /// Tighter bounds for certificates near t (in that piece): those of the part of the piece
+  /// around t (about 3/8 of it along each direction; StepBounds::lo/hi say which part).
+  const StepBounds& step_bounds(int piece, const Vec3& t) const noexcept;
 
   /// Implementation data (Bernstein nets, BVH); opaque.
   struct Data;

@@ -117,6 +117,10 @@ public:
   /// out: count * materials()).
   void fractions(const float* props, std::size_t count, float* out) const noexcept;
 
+  /// fractions() for the voxels with cell[v] >= 0 among `count` (the others' outputs are left as
+  /// they are): the print job's batch form, with a fast path for colour-only models.
+  void fractions(const float* props, const std::int32_t* cell, std::size_t count, float* out) const noexcept;
+
   /// One line for the job summary, e.g. "r,g,b -> VeroCyan-V/VeroMagenta-V/VeroYellow-V/
   /// VeroBlack/VeroUltraWhite (subtractive CMYK + white); UltraClear -> UltraClear; ignored:
   /// density; default VeroUltraWhite".
