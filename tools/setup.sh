@@ -9,7 +9,7 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev libopenvdb-tools python3-openvdb
   libopenimageio-dev libopencv-core-dev openimageio-tools python3-openimageio
   catch2 libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
-  libpugixml-dev libzip-dev zip unzip
+  libpugixml-dev libzip-dev zip unzip libssl-dev
 )
 
 missing=()

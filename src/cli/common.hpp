@@ -21,6 +21,8 @@ void add_locate(CLI::App& app, Common& common);
 void add_slice(CLI::App& app, Common& common);
 void add_inspect(CLI::App& app, Common& common);
 void add_preview(CLI::App& app, Common& common);
+void add_render(CLI::App& app, Common& common);
+void add_merge(CLI::App& app, Common& common);
 
 /// Parses "a,b,c" into exactly `count` finite numbers.
 /// @param option  the option's name, for the message ("--uvw")

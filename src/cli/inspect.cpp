@@ -2,13 +2,18 @@
 // configuration, which slices are missing or corrupt, voxels and volume per material. Exit 1
 // when the stack is invalid (a slice missing or corrupt, or a VoxelCount that the pixels
 // contradict), after printing the report; exit 2 when the folder or its ConfigFile.xml is unusable.
+// `trivox inspect FILE.vdb` (a .vdb name, or any file starting with OpenVDB's magic number):
+// the grids of an OpenVDB file (io::inspect_vdb); exit 2 when it is missing, not a VDB file or
+// corrupt.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 
 #include "common.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/slice_stack.hpp"
+#include "trivox/io/vdb_inspect.hpp"
 
 namespace trivox::cli {
 
@@ -111,18 +116,154 @@ void print_human(const io::StackReport& r, const std::string& path) {
   std::printf("\n%s\n", r.valid() ? "stack is valid" : "stack is INVALID");
 }
 
+// ---- .vdb files ----
+
+nlohmann::ordered_json meta_json(const std::vector<io::VdbMeta>& meta) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  for (const auto& m : meta) {
+    if (m.type == "bool")
+      j[m.name] = m.value == "1" || m.value == "true";
+    else if (m.numeric)
+      j[m.name] = m.type == "int32" || m.type == "int64" ? nlohmann::ordered_json(std::stoll(m.value))
+                                                         : nlohmann::ordered_json(std::stod(m.value));
+    else
+      j[m.name] = m.value;
+  }
+  return j;
+}
+
+nlohmann::ordered_json values_json(const std::vector<double>& v, int components) {
+  if (v.empty()) return nullptr;
+  if (components == 1) return v[0];
+  return v;
+}
+
+nlohmann::ordered_json vdb_json(const io::VdbReport& r) {
+  nlohmann::ordered_json grids = nlohmann::ordered_json::array();
+  for (const auto& g : r.grids) {
+    nlohmann::ordered_json j = {{"name", g.name},
+                                {"type", g.type},
+                                {"class", g.grid_class},
+                                {"voxel_size", g.voxel_size},
+                                {"active_voxels", g.active_voxels}};
+    if (g.empty) {
+      j["index_bounds"] = nullptr;
+      j["world_bounds"] = nullptr;
+    } else {
+      j["index_bounds"] = g.index_bounds;
+      j["world_bounds"] = g.world_bounds;
+    }
+    j["min"] = values_json(g.min, g.components);
+    j["max"] = values_json(g.max, g.components);
+    j["mean"] = values_json(g.mean, g.components);
+    j["metadata"] = meta_json(g.metadata);
+    grids.push_back(std::move(j));
+  }
+  nlohmann::ordered_json materials = nlohmann::ordered_json::array();
+  for (const auto& m : r.materials) materials.push_back({{"name", m.name}, {"volume_mm3", m.volume}});
+  return {{"path", r.path},
+          {"kind", "vdb"},
+          {"bytes", r.bytes},
+          {"format", r.format},
+          {"units", r.units.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(r.units)},
+          {"metadata", meta_json(r.metadata)},
+          {"grids", grids},
+          {"volume_mm3", r.volume ? nlohmann::ordered_json(*r.volume) : nlohmann::ordered_json(nullptr)},
+          {"materials", materials}};
+}
+
+std::string values_text(const std::vector<double>& v) {
+  if (v.empty()) return "-";
+  if (v.size() == 1) return fmt(v[0], 6);
+  std::string s = "(";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + fmt(v[i], 4);
+  return s + ")";
+}
+
+template <class T>
+std::string triple(const std::array<T, 3>& v, int digits = 6) {
+  std::string s = "(";
+  for (std::size_t i = 0; i < 3; ++i) s += (i ? ", " : "") + fmt(static_cast<double>(v[i]), digits);
+  return s + ")";
+}
+
+std::string bytes_text(std::int64_t b) {
+  const char* units[] = {"B", "KB", "MB", "GB", "TB"};
+  double v = static_cast<double>(b);
+  int u = 0;
+  while (v >= 1000.0 && u < 4) v /= 1000.0, ++u;
+  return fmt(v, 3) + " " + units[u];
+}
+
+void print_vdb(const io::VdbReport& r) {
+  std::printf("%s: OpenVDB file (library/format %s), %zu grids, %s\n", r.path.c_str(), r.format.c_str(), r.grids.size(),
+              bytes_text(r.bytes).c_str());
+  if (!r.metadata.empty()) {
+    std::printf("file metadata:\n");
+    for (const auto& m : r.metadata) std::printf("  %-20s %s\n", m.name.c_str(), m.value.c_str());
+  }
+  std::size_t w = 20;
+  for (const auto& g : r.grids) w = std::max(w, g.name.size());
+  const int wi = static_cast<int>(w);
+  std::printf("\n%-*s %-6s %-11s %-10s %13s  %-22s %-22s %s\n", wi, "grid", "type", "class", "voxel", "active voxels", "min",
+              "max", "mean");
+  for (const auto& g : r.grids) {
+    const bool uniform = g.voxel_size[0] == g.voxel_size[1] && g.voxel_size[1] == g.voxel_size[2];
+    const std::string voxel = uniform ? fmt(g.voxel_size[0], 6) : triple(g.voxel_size, 4);
+    std::printf("%-*s %-6s %-11s %-10s %13lld  %-22s %-22s %s\n", wi, g.name.c_str(), g.type.c_str(),
+                g.grid_class.c_str(), voxel.c_str(), static_cast<long long>(g.active_voxels), values_text(g.min).c_str(),
+                values_text(g.max).c_str(), values_text(g.mean).c_str());
+  }
+  std::printf("\n%-*s %-34s %s\n", wi, "active bounds", "index (voxels, inclusive)", "world (voxel boxes)");
+  for (const auto& g : r.grids) {
+    if (g.empty) {
+      std::printf("%-*s %s\n", wi, g.name.c_str(), "(no active voxels)");
+      continue;
+    }
+    const std::string index = triple(g.index_bounds[0]) + " - " + triple(g.index_bounds[1]);
+    std::printf("%-*s %-34s %s - %s\n", wi, g.name.c_str(), index.c_str(), triple(g.world_bounds[0]).c_str(),
+                triple(g.world_bounds[1]).c_str());
+  }
+  const std::string unit = r.units.empty() ? "units" : r.units;
+  if (r.volume) {
+    std::printf("\nvolume: %s %s^3 (sum of density x voxel volume)\n", fmt(*r.volume, 10).c_str(), unit.c_str());
+    if (!r.materials.empty()) {
+      std::printf("\n%-*s %16s\n", wi, "material", (unit + "^3").c_str());
+      for (const auto& m : r.materials) std::printf("%-*s %16s\n", wi, m.name.c_str(), fmt(m.volume, 10).c_str());
+    }
+  } else {
+    std::printf("\nvolume: no float grid \"density\"\n");
+  }
+}
+
+bool vdb_name(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".vdb";
+}
+
 }  // namespace
 
 void add_inspect(CLI::App& app, Common& common) {
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
-      "inspect", "Read a slice folder back: configuration, missing or corrupt slices, voxels and volume per material");
-  sub->add_option("DIR", opt->path, "Slice folder (holding ConfigFile.xml and the PNG slices)")->required();
+      "inspect", "Read a slice folder or a .vdb file back: configuration or grids, problems, voxels and volume per material");
+  sub->add_option("PATH", opt->path, "Slice folder (holding ConfigFile.xml and the PNG slices), or an OpenVDB file (.vdb)")->required();
   sub->add_flag("--json", common.json, "Print one JSON object instead of the summary");
   sub->callback([opt, &common] {
     std::error_code ec;
-    if (std::filesystem::is_regular_file(opt->path, ec))
-      throw Error(opt->path + ": is a file; expected a slice folder holding ConfigFile.xml (unzip a .gcvf first)");
+    const std::filesystem::path path(opt->path);
+    if (vdb_name(path) || (std::filesystem::is_regular_file(path, ec) && io::looks_like_vdb(path))) {
+      const io::VdbReport r = io::inspect_vdb(path);
+      if (common.json)
+        print_json(vdb_json(r));
+      else
+        print_vdb(r);
+      return;
+    }
+    if (std::filesystem::is_regular_file(path, ec))
+      throw Error(opt->path + ": is a file; expected a slice folder holding ConfigFile.xml (unzip a .gcvf first) "
+                  "or an OpenVDB file (.vdb)");
     const io::StackReport r = io::inspect_stack(opt->path);
     if (common.json)
       print_json(to_json(r, opt->path));

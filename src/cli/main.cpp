@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   trivox::cli::add_slice(app, common);
   trivox::cli::add_inspect(app, common);
   trivox::cli::add_preview(app, common);
+  trivox::cli::add_render(app, common);
+  trivox::cli::add_merge(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,14 +1,20 @@
-// `trivox slice MODEL -o DIR`: the print job (PNG stack + ConfigFile.xml for GrabCAD Voxel Print).
+// `trivox slice MODEL -o DIR`: the print job: the PNG stack + ConfigFile.xml for GrabCAD Voxel Print
+// (`--png`, the default) and/or the OpenVDB volume DIR/<model>.vdb (`--vdb`).
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include <charconv>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 #include "common.hpp"
 #include "trivox/error.hpp"
+#include "trivox/io/manifest.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_job.hpp"
+#include "trivox/io/vdb_job.hpp"
 
 namespace trivox::cli {
 
@@ -20,6 +26,12 @@ struct Options {
   int threads = 0;
   bool zip = false, force = false;
   std::int64_t max_voxels = 100'000'000'000;
+  bool png = false, vdb = false;
+  double vdb_voxel = 0.0;
+  int supersample = 1;
+  bool resume = false;
+  std::string shard;
+  int shard_count = 0;
 };
 
 std::string duration(double s) {
@@ -31,32 +43,99 @@ std::string duration(double s) {
 }
 
 /// Progress on stderr: a bar redrawn in place on a terminal, a line every 5 s otherwise.
-io::SliceProgress make_progress(const std::string& mode) {
+/// @param unit  what is counted ("layers"; "blocks" for the VDB's 8-layer blocks)
+/// @param what  what per second ("voxels"; "samples")
+io::SliceProgress make_progress(const std::string& mode, const char* unit = "layers", const char* what = "voxels") {
   if (mode == "never") return {};
   const bool bar = mode == "bar" || (mode == "auto" && isatty(STDERR_FILENO));
   auto last = std::make_shared<double>(-1e9);
-  return [bar, last](int done, int total, std::int64_t voxels, double seconds) {
+  return [bar, last, unit, what](int done, int total, std::int64_t voxels, double seconds) {
     const double rate = seconds > 0 ? voxels / seconds : 0.0;
     const double eta = done > 0 ? seconds * (total - done) / done : 0.0;
     if (bar) {
       const int width = 30, fill = total ? done * width / total : width;
-      std::fprintf(stderr, "\r[%.*s%.*s] %d/%d layers, %.3g voxels/s, ETA %s   ", fill,
-                   "##############################", width - fill, "..............................", done, total,
-                   rate, duration(eta).c_str());
+      std::fprintf(stderr, "\r[%.*s%.*s] %d/%d %s, %.3g %s/s, ETA %s   ", fill, "##############################",
+                   width - fill, "..............................", done, total, unit, rate, what, duration(eta).c_str());
       if (done == total) std::fprintf(stderr, "\n");
     } else if (seconds - *last >= 5.0 || done == total) {
       *last = seconds;
-      std::fprintf(stderr, "trivox slice: %d/%d layers, %.3g voxels/s, elapsed %s, ETA %s\n", done, total, rate,
+      std::fprintf(stderr, "trivox slice: %d/%d %s, %.3g %s/s, elapsed %s, ETA %s\n", done, total, unit, rate, what,
                    duration(seconds).c_str(), duration(eta).c_str());
     }
   };
+}
+
+/// The shortest text that reads back to `v` (manifest option values).
+std::string canonical(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::string human_bytes(double b) {
+  const char* units[] = {"B", "KB", "MB", "GB", "TB"};
+  int u = 0;
+  while (b >= 1000.0 && u < 4) b /= 1000.0, ++u;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g %s", b, units[u]);
+  return buf;
+}
+
+nlohmann::ordered_json vdb_json(const io::VdbJobSummary& v) {
+  nlohmann::ordered_json mats = nlohmann::ordered_json::array();
+  for (std::size_t m = 0; m < v.materials.size(); ++m)
+    mats.push_back({{"name", v.materials[m]}, {"volume_mm3", v.material_volume_mm3[m]}});
+  return {{"file", v.file.string()},
+          {"voxel_mm", v.plan.voxel_mm},
+          {"voxel_automatic", v.plan.automatic},
+          {"supersample", v.plan.supersample},
+          {"grid", {{"origin", v.plan.origin}, {"count", v.plan.count}}},
+          {"grids", v.grids},
+          {"active_voxels", v.active_voxels},
+          {"fractional_voxels", v.fractional_voxels},
+          {"samples", v.samples},
+          {"volume_mm3", v.volume_mm3},
+          {"estimated_volume_mm3", v.plan.estimated_volume_mm3},
+          {"colour_source", v.colour_source},
+          {"palette", v.palette},
+          {"materials", mats},
+          {"inversion_failures", v.inversion_failures},
+          {"bytes", v.bytes},
+          {"sha256", v.sha256},
+          {"seconds", v.seconds}};
+}
+
+void print_vdb(const io::VdbJobSummary& v) {
+  const auto& p = v.plan;
+  std::string grids;
+  for (const auto& g : v.grids) grids += (grids.empty() ? "" : ", ") + g;
+  std::printf("vdb: %s: %zu grids (%s), %s\n", v.file.string().c_str(), v.grids.size(), grids.c_str(),
+              human_bytes(static_cast<double>(v.bytes)).c_str());
+  if (p.automatic)
+    std::printf("voxel %s mm (automatic: volume %s mm^3 / voxel^3 = about %.3g active voxels, below %.3g), supersample %d\n",
+                fmt(p.voxel_mm, 6).c_str(), fmt(p.estimated_volume_mm3, 8).c_str(), p.estimated_active_voxels, 5e7,
+                p.supersample);
+  else
+    std::printf("voxel %s mm (--vdb-voxel), supersample %d\n", fmt(p.voxel_mm, 6).c_str(), p.supersample);
+  std::printf("box %d x %d x %d voxels from (%s, %s, %s) mm; time %s\n", p.count[0], p.count[1], p.count[2],
+              fmt(p.origin[0], 6).c_str(), fmt(p.origin[1], 6).c_str(), fmt(p.origin[2], 6).c_str(),
+              duration(v.seconds).c_str());
+  std::printf("active voxels %lld (%lld fractional), volume %s mm^3 (quadrature %s mm^3)\n",
+              static_cast<long long>(v.active_voxels), static_cast<long long>(v.fractional_voxels),
+              fmt(v.volume_mm3, 8).c_str(), fmt(p.estimated_volume_mm3, 8).c_str());
+  std::printf("colour from %s; material volumes (fractions before dithering, palette %s):\n",
+              v.colour_source == "r,g,b" ? "the model's r, g, b" : "the palette colours", v.palette.c_str());
+  for (std::size_t m = 0; m < v.materials.size(); ++m)
+    if (v.material_volume_mm3[m] > 0)
+      std::printf("  %-16s %14.3f mm^3\n", v.materials[m].c_str(), v.material_volume_mm3[m]);
+  std::printf("inversion failures: %lld\n", static_cast<long long>(v.inversion_failures));
 }
 
 }  // namespace
 
 void add_slice(CLI::App& app, Common& common) {
   auto opt = std::make_shared<Options>();
-  CLI::App* sub = app.add_subcommand("slice", "Slice a model into a GrabCAD Voxel Print PNG stack");
+  CLI::App* sub = app.add_subcommand("slice", "Slice a model into a GrabCAD Voxel Print PNG stack and/or an OpenVDB volume");
   sub->add_option("MODEL", opt->model, "Model file (.json, or G+Smo .xml)")->required();
   sub->add_option("-o,--output", opt->out, "Output folder (new or empty)")->required();
   sub->add_option("--printer", opt->printer, "Printer preset: j750, j850 (600 x 300 dpi, 27 um layers)");
@@ -69,13 +148,67 @@ void add_slice(CLI::App& app, Common& common) {
   sub->add_option("--max-voxels", opt->max_voxels, "Refuse larger grids unless --force (default 1e11)");
   sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)");
   sub->add_option("--progress", opt->progress, "auto (bar on a terminal, lines otherwise), bar, lines, never");
+  sub->add_flag("--png", opt->png, "Write the PNG stack (the default without --vdb)");
+  sub->add_flag("--vdb", opt->vdb, "Write the OpenVDB volume DIR/<model>.vdb (with --png: both)");
+  sub->add_option("--vdb-voxel", opt->vdb_voxel, "VDB voxel edge in mm (default: about 5e7 active voxels)");
+  sub->add_option("--supersample", opt->supersample, "VDB: N^3 samples per voxel for fractional density, 1..8 (default 1)");
+  sub->add_flag("--resume", opt->resume, "Continue the job in DIR: keep the layers its manifest lists and that verify");
+  sub->add_option("--shard", opt->shard, "Slice only part K of N of the layers (K from 0: 0/3, 1/3, 2/3); see trivox merge");
+  sub->add_option("--shard-count", opt->shard_count, "Shards of a Kubernetes Indexed Job (the index: JOB_COMPLETION_INDEX)");
   sub->add_flag("--json", common.json, "Print the summary as one JSON object");
-  sub->callback([opt, &common] {
+  sub->callback([opt, &common, sub] {
+    const bool want_vdb = opt->vdb, want_png = opt->png || !opt->vdb;
+    if (!want_vdb)
+      for (const char* o : {"--vdb-voxel", "--supersample"})
+        if (sub->count(o) > 0) throw Error(std::string(o) + ": applies to the VDB output; expected --vdb with it");
+    if (!want_png)
+      for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels"})
+        if (sub->count(o) > 0)
+          throw Error(std::string(o) + ": applies to the PNG stack; expected --png with it (--vdb alone writes only the VDB)");
     if (opt->progress != "auto" && opt->progress != "bar" && opt->progress != "lines" && opt->progress != "never")
       throw Error("--progress " + opt->progress + ": unknown mode; expected auto, bar, lines or never");
     if (opt->threads < 0 || opt->threads > 1024)
       throw Error("--threads " + std::to_string(opt->threads) + ": out of range; expected 1 to 1024 (0: all cores)");
+    // The shard: --shard wins over a scheduler's environment (Slurm arrays, Kubernetes).
+    io::Shard shard;
+    if (!opt->shard.empty()) shard = io::parse_shard(opt->shard);
+    else if (const auto env = io::shard_from_environment(sub->count("--shard-count") ? std::optional<int>(opt->shard_count) : std::nullopt))
+      shard = *env;
+    else if (sub->count("--shard-count"))
+      throw Error("--shard-count " + std::to_string(opt->shard_count) +
+                  ": without JOB_COMPLETION_INDEX in the environment; expected a Kubernetes Indexed Job, or --shard K/N");
+    if (!want_png && (shard.count > 1 || opt->resume))
+      throw Error(std::string(shard.count > 1 ? "--shard" : "--resume") +
+                  ": works on jobs with the PNG stack, whose manifest lists the layers; expected --png with --vdb");
     const auto model = io::load_model(opt->model);
+    io::VdbJobOptions vj;
+    std::optional<io::VdbPlan> plan;
+    if (want_vdb) {
+      vj.out_dir = opt->out;
+      vj.model_file = opt->model;
+      if (!opt->palette.empty()) vj.palette = opt->palette;
+      if (sub->count("--vdb-voxel") > 0) vj.voxel_mm = opt->vdb_voxel;
+      vj.supersample = opt->supersample;
+      vj.force = opt->force;
+      vj.require_empty_folder = !want_png;
+      plan = io::plan_vdb_job(model, vj);  // bad VDB options fail before the PNG stack is written
+      if (shard.count > 1) {  // this shard's whole leaves, in a part of its own
+        vj.layer_range = shard.range(plan->count[2]);
+        vj.file_name = shard.part_name(plan->file.filename().string());
+        plan = io::plan_vdb_job(model, vj);
+      }
+    }
+    std::unique_ptr<tbb::global_control> limit;
+    if (opt->threads > 0)
+      limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    static_cast<std::size_t>(opt->threads));
+    if (!want_png) {
+      const auto v = io::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
+      if (common.json) return print_json({{"model", opt->model}, {"output", opt->out}, {"vdb", vdb_json(v)}});
+      std::printf("sampled %s -> %s\n", opt->model.c_str(), opt->out.c_str());
+      print_vdb(v);
+      return;
+    }
     io::SliceJobOptions job;
     job.profile = slice::printer_preset(opt->printer);
     if (!opt->dpi.empty()) {
@@ -94,12 +227,34 @@ void add_slice(CLI::App& app, Common& common) {
     job.dither = opt->dither;
     job.force = opt->force;
     job.zip = opt->zip;
+    // The manifest's identity of the job (manifest.hpp): the model's bytes and the VDB's options.
+    job.model_file = opt->model;
+    job.model_sha256 = io::sha256_file(opt->model);
+    job.extra_options["vdb"] = want_vdb ? "yes" : "no";
+    if (plan) {
+      job.extra_options["vdb.voxel_mm"] = canonical(plan->voxel_mm);
+      job.extra_options["vdb.supersample"] = std::to_string(plan->supersample);
+    }
+    job.last_output = !want_vdb;  // the VDB follows and completes the manifest
     job.max_voxels = opt->max_voxels;
-    std::unique_ptr<tbb::global_control> limit;
-    if (opt->threads > 0)
-      limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                    static_cast<std::size_t>(opt->threads));
+    job.resume = opt->resume;
+    job.shard = shard;
+    // A resumed job keeps its VDB when the manifest lists it and it verifies.
+    std::optional<io::ManifestFile> vdb_done;
+    if (want_vdb && opt->resume)
+      if (const auto m = io::read_manifest(opt->out, shard.manifest_name()))
+        for (const auto& f : m->files)
+          if (f.role == "vdb" && f.file == plan->file.filename().string() && std::filesystem::is_regular_file(plan->file) &&
+              io::sha256_file(plan->file) == f.sha256)
+            vdb_done = f;
     const auto s = io::run_slice_job(model, job, make_progress(opt->progress));
+    std::optional<io::VdbJobSummary> v;
+    if (want_vdb && vdb_done) {
+      io::finish_manifest(opt->out, s.shard, {*vdb_done});
+    } else if (want_vdb) {
+      v = io::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
+      io::finish_manifest(opt->out, s.shard, {{"vdb", v->file.filename().string(), v->sha256}});
+    }
 
     nlohmann::ordered_json mats = nlohmann::ordered_json::array();
     for (std::size_t m = 0; m < s.materials.size(); ++m)
@@ -120,8 +275,14 @@ void add_slice(CLI::App& app, Common& common) {
                                 {"voxels_per_second", s.seconds > 0 ? s.voxels / s.seconds : 0.0},
                                 {"inversion_failures", s.inversion_failures},
                                 {"mapping", s.mapping},
-                                {"materials", mats}};
+                                {"materials", mats},
+                                {"shard", {{"index", s.shard.index}, {"count", s.shard.count}}},
+                                {"layer_range", s.layer_range},
+                                {"layers_kept", s.layers_kept},
+                                {"manifest", (std::filesystem::path(opt->out) / s.shard.manifest_name()).string()}};
+    if (vdb_done) j["vdb_kept"] = vdb_done->file;
     if (!s.zip_file.empty()) j["zip"] = s.zip_file.string();
+    if (v) j["vdb"] = vdb_json(*v);
     if (common.json) return print_json(j);
     std::printf("sliced %s -> %s: %d x %d pixels x %d layers (%s, %g x %g dpi, %g mm layers)\n", opt->model.c_str(),
                 opt->out.c_str(), s.grid.count[0], s.grid.count[1], s.grid.count[2], job.profile.name.c_str(),
@@ -135,7 +296,13 @@ void add_slice(CLI::App& app, Common& common) {
         std::printf("  %-16s %14lld voxels %14.3f mm^3\n", s.materials[m].c_str(),
                     static_cast<long long>(s.material_voxels[m]), s.material_voxels[m] * s.voxel_volume_mm3);
     std::printf("inversion failures: %lld\n", static_cast<long long>(s.inversion_failures));
+    if (s.shard.count > 1)
+      std::printf("shard %d/%d: layers %d to %d; when every shard is done: trivox merge %s\n", s.shard.index,
+                  s.shard.count, s.layer_range[0], s.layer_range[1] - 1, opt->out.c_str());
+    if (s.layers_kept > 0) std::printf("resumed: %d layers kept (verified against the manifest)\n", s.layers_kept);
+    if (vdb_done) std::printf("resumed: %s kept (verified against the manifest)\n", vdb_done->file.c_str());
     if (!s.zip_file.empty()) std::printf("packed: %s\n", s.zip_file.string().c_str());
+    if (v) print_vdb(*v);
   });
 }
 

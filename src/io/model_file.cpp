@@ -180,17 +180,27 @@ vmodel::VModel load_model(const fs::path& path) {
   return read_model(text, path.string());
 }
 
-void write_file_atomically(const fs::path& path, std::string_view bytes) {
+void sync_folder_contents(const fs::path& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) throw Error(dir.string() + ": cannot open the folder to sync it: " + system_reason(errno), ErrorKind::failed);
+  const int rc = ::syncfs(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) throw Error(dir.string() + ": writing the files to disk failed: " + system_reason(err), ErrorKind::failed);
+}
+
+void write_file_atomically(const fs::path& path, std::string_view bytes, Durability durability) {
   std::error_code ec;
   if (fs::is_directory(path, ec))
     throw Error(path.string() + ": is a folder; expected a file path to write");
   fs::path tmp;
   Fd fd(create_temporary(path, tmp));
   if (fd.get() < 0) write_failed(path, {}, errno);
-  if (!write_all(fd.get(), bytes) || ::fsync(fd.get()) != 0) write_failed(path, tmp, errno);
+  const bool sync = durability == Durability::synced;
+  if (!write_all(fd.get(), bytes) || (sync && ::fsync(fd.get()) != 0)) write_failed(path, tmp, errno);
   if (fd.close() != 0) write_failed(path, tmp, errno);
   if (::rename(tmp.c_str(), path.c_str()) != 0) write_failed(path, tmp, errno);
-  sync_folder(path);
+  if (sync) sync_folder(path);
 }
 
 void save_model(const vmodel::VModel& model, const fs::path& path) {

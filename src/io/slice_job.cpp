@@ -1,6 +1,7 @@
 #include "trivox/io/slice_job.hpp"
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -8,11 +9,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <map>
 #include <system_error>
 
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_stack.hpp"
+#include "trivox/version.hpp"
 #include "trivox/slice/dither.hpp"
 #include "trivox/slice/material.hpp"
 #include "trivox/slice/sampler.hpp"
@@ -41,25 +46,60 @@ void check_profile(const slice::PrintProfile& p) {
     throw Error("--layer " + std::to_string(p.layer_mm) + ": out of range; expected a layer of 0.001 to 10 mm");
 }
 
-/// The output folder: created, or empty, or --force.
-void prepare_folder(const fs::path& dir, bool force) {
+bool is_manifest_name(const std::string& name) {
+  return name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json"));
+}
+
+/// The output folder, created if absent. A whole job without --resume wants it new or empty
+/// (or --force); shards share one folder with their siblings; and any manifest in it must be
+/// of the same job (or --force). Returns this job's (part's) manifest when resuming it.
+std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& id, const SliceJobOptions& opt) {
   std::error_code ec;
+  std::optional<Manifest> own;
   if (fs::exists(dir, ec)) {
     if (!fs::is_directory(dir, ec))
       throw Error(dir.string() + ": exists and is not a folder; expected a new or empty folder for the slices");
-    if (!force && fs::directory_iterator(dir, ec) != fs::directory_iterator())
-      throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (or --force to overwrite)");
-  } else if (!fs::create_directories(dir, ec) || ec) {
+    bool empty = true, same_job_there = false;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.starts_with(".trivox-write-test")) continue;
+      empty = false;
+      if (!is_manifest_name(name)) continue;
+      const auto m = read_manifest(dir, name);
+      if (const std::string why = id.difference(*m); !why.empty()) {
+        if (!opt.force)
+          throw Error(dir.string() + ": holds another job (" + name + ": " + why +
+                      "); expected the same model and options to resume or add shards (or --force to overwrite, or "
+                      "another folder)");
+        continue;
+      }
+      same_job_there = true;
+      if (name == id.shard.manifest_name()) own = *m;
+    }
+    if (!empty && !opt.force && !opt.resume && id.shard.count == 1)
+      throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (" +
+                  (same_job_there ? std::string("--resume to continue the unfinished job there, ") : std::string()) +
+                  "or --force to overwrite)");
+  } else if ((!fs::create_directories(dir, ec) || ec) && !fs::is_directory(dir)) {  // a sibling shard may win
     throw Error(dir.string() + ": cannot create the folder (" + ec.message() + "); expected a writable location");
   }
-  // Probe writability now rather than after the first layer.
-  const fs::path probe = dir / ".trivox-write-test";
+  // Probe writability now rather than after the first layer (a name of this shard's own).
+  const fs::path probe = dir / (".trivox-write-test" + (id.shard.count > 1 ? "-" + std::to_string(id.shard.index) : std::string()));
   try {
     write_file_atomically(probe, "");
   } catch (const Error& e) {
     throw Error(dir.string() + ": the folder is not writable; expected a writable folder");
   }
   fs::remove(probe, ec);
+  if (!opt.resume) own.reset();
+  return own;
+}
+
+/// Canonical text of a number for the manifest's options (round-trips).
+std::string canonical(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
 }
 
 /// Per-worker scratch, reused across layers so a job allocates once per thread.
@@ -68,7 +108,17 @@ struct Scratch {
   std::vector<float> fractions;
   std::vector<std::uint8_t> chosen;
   std::vector<std::uint8_t> rgba;
+  std::array<double, 5> seconds{};  ///< per stage, see SliceJobSummary::stage_seconds
 };
+
+using Clock = std::chrono::steady_clock;
+
+/// Adds the time since `t` to `acc` and moves `t` to now.
+inline void lap(Clock::time_point& t, double& acc) {
+  const auto now = Clock::now();
+  acc += std::chrono::duration<double>(now - t).count();
+  t = now;
+}
 
 /// One layer on its way through the pipeline.
 struct LayerOut {
@@ -76,6 +126,7 @@ struct LayerOut {
   std::string png;
   std::vector<std::int64_t> counts;
   std::int64_t failures = 0;
+  std::string sha256;  ///< of png
 };
 
 }  // namespace
@@ -115,7 +166,6 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
   const slice::MaterialMapper mapper(palette, model.properties);
   const slice::DitherMode mode = slice::parse_dither_mode(opt.dither);
-  prepare_folder(opt.out_dir, opt.force);
 
   const slice::LayerSampler sampler(model, grid);
   const int nx = grid.count[0], ny = grid.count[1], nz = grid.count[2];
@@ -123,55 +173,110 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const int nprops = static_cast<int>(model.properties.size());
   const int band_rows = std::max(1, std::min(opt.band_rows, ny));
 
-  StackConfig cfg;
-  cfg.dpi_x = opt.profile.dpi_x;
-  cfg.dpi_y = opt.profile.dpi_y;
-  cfg.slice_thickness_nm = opt.profile.layer_mm * 1e6;
-  cfg.width = nx;
-  cfg.height = ny;
-  cfg.slices = nz;
-  cfg.digits = std::max(5, static_cast<int>(std::to_string(nz).size()));
+
+  // Pixel colours by material index; 255 (void) and unused indices are transparent black.
+  std::array<std::uint32_t, 256> colour{};
+  for (int m = 0; m < nmat; ++m) std::memcpy(&colour[static_cast<std::size_t>(m)], palette.materials[static_cast<std::size_t>(m)].rgba.data(), 4);
+
+  // The job's identity and the folder; when resuming, the layers that are done and verify.
+  Manifest manifest;
+  manifest.trivox = version;
+  manifest.model_file = opt.model_file.empty() ? opt.model_name : opt.model_file;
+  manifest.model_sha256 = opt.model_sha256;
+  manifest.options = opt.extra_options;
+  manifest.options["png.dpi"] = canonical(opt.profile.dpi_x) + "," + canonical(opt.profile.dpi_y);
+  manifest.options["png.layer_mm"] = canonical(opt.profile.layer_mm);
+  manifest.options["png.printer"] = opt.profile.name;
+  manifest.options["png.palette"] = palette.name + (opt.palette ? " " + sha256_file(*opt.palette) : std::string(" (built in)"));
+  manifest.options["png.dither"] = std::string(slice::dither_mode_name(mode));
+  manifest.options["png.zip"] = opt.zip ? "yes" : "no";
+  manifest.grid = grid.count;
+  manifest.dpi_x = opt.profile.dpi_x;
+  manifest.dpi_y = opt.profile.dpi_y;
+  manifest.layer_mm = opt.profile.layer_mm;
+  for (const auto& mat : palette.materials) {
+    manifest.materials.push_back(mat.name);
+    manifest.colours.push_back(mat.rgba);
+  }
+  manifest.shard = opt.shard;
+  manifest.layer_range = opt.shard.range(nz);
+  const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt);
+  StackConfig cfg = stack_config_of(manifest, {});
+
+  std::map<int, ManifestLayer> finished;  // by layer
+  std::vector<int> todo;
+  {
+    std::vector<char> keep(static_cast<std::size_t>(nz), 0);
+    if (previous)
+      tbb::parallel_for(manifest.layer_range[0], manifest.layer_range[1], [&](int k) {
+        const ManifestLayer* l = previous->layer(k);
+        std::error_code ec;
+        const fs::path f = opt.out_dir / cfg.slice_name(k);
+        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && fs::is_regular_file(f, ec) && sha256_file(f) == l->sha256;
+      });
+    for (int k = manifest.layer_range[0]; k < manifest.layer_range[1]; ++k)
+      if (keep[static_cast<std::size_t>(k)]) finished.emplace(k, *previous->layer(k));
+      else todo.push_back(k);
+  }
+  const int kept = static_cast<int>(finished.size());
+  const int total_layers = manifest.layer_range[1] - manifest.layer_range[0];
+
+  // The manifest lists only layers already on disk: sync first.
+  auto write_manifest = [&](bool complete) {
+    sync_folder_contents(opt.out_dir);
+    manifest.layers.clear();
+    for (const auto& [k, l] : finished) manifest.layers.push_back(l);
+    manifest.complete = complete;
+    write_file_atomically(opt.out_dir / manifest.shard.manifest_name(), manifest_json(manifest));
+  };
+  write_manifest(false);
+  auto last_manifest = Clock::now();
 
   tbb::enumerable_thread_specific<Scratch> scratch;
-  std::vector<std::int64_t> totals(static_cast<std::size_t>(nmat), 0);
-  std::int64_t failures = 0;
-  int done = 0;
+  int done = kept;
   const int tokens = static_cast<int>(tbb::this_task_arena::max_concurrency()) + 1;
-  int next = 0;
+  std::size_t next = 0;
 
   auto sample_layer = [&](int k) {
     LayerOut out;
     out.layer = k;
     out.counts.assign(static_cast<std::size_t>(nmat), 0);
     Scratch& s = scratch.local();
-    s.rgba.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * 4, 0);
+    s.rgba.resize(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * 4);
+    std::array<std::int64_t, 256> histogram{};
     slice::LayerDitherer dither(mode, nx, nmat, grid.pitch[0], grid.pitch[1]);
     dither.begin_layer(k);
+    auto t = Clock::now();
     for (int r0 = 0; r0 < ny; r0 += band_rows) {
       const int rows = std::min(band_rows, ny - r0);
       sampler.sample(k, r0, rows, s.band);
+      lap(t, s.seconds[0]);
       out.failures += s.band.failures;
-      const std::size_t n = static_cast<std::size_t>(rows) * static_cast<std::size_t>(nx);
-      s.fractions.resize(n * static_cast<std::size_t>(nmat));
-      s.chosen.resize(n);
-      for (std::size_t v = 0; v < n; ++v)
-        if (s.band.cell[v] >= 0)
-          mapper.fractions(s.band.props.data() + v * static_cast<std::size_t>(nprops),
-                           s.fractions.data() + v * static_cast<std::size_t>(nmat));
-      dither.dither(r0, rows, s.band.cell.data(), s.fractions.data(), s.chosen.data());
-      std::uint8_t* px = s.rgba.data() + static_cast<std::size_t>(r0) * static_cast<std::size_t>(nx) * 4;
-      for (std::size_t v = 0; v < n; ++v) {
-        const std::uint8_t m = s.chosen[v];
-        if (m == 255) continue;  // void stays transparent 0 0 0 0
-        const auto& c = palette.materials[m].rgba;
-        px[4 * v + 0] = c[0];
-        px[4 * v + 1] = c[1];
-        px[4 * v + 2] = c[2];
-        px[4 * v + 3] = c[3];
-        ++out.counts[m];
+      // Row by row, so the fractions and material indices stay in the L1/L2 cache.
+      const auto unx = static_cast<std::size_t>(nx);
+      s.fractions.resize(unx * static_cast<std::size_t>(nmat));
+      s.chosen.resize(unx);
+      for (int r = 0; r < rows; ++r) {
+        const std::int32_t* cell = s.band.cell.data() + static_cast<std::size_t>(r) * unx;
+        mapper.fractions(s.band.props.data() + static_cast<std::size_t>(r) * unx * static_cast<std::size_t>(nprops), cell,
+                         unx, s.fractions.data());
+        lap(t, s.seconds[1]);
+        dither.dither(r0 + r, 1, cell, s.fractions.data(), s.chosen.data());
+        lap(t, s.seconds[2]);
+        // Every pixel written (void: transparent 0 0 0 0), so the image needs no clearing.
+        std::uint8_t* px = s.rgba.data() + static_cast<std::size_t>(r0 + r) * unx * 4;
+        for (std::size_t v = 0; v < unx; ++v) {
+          const std::uint8_t m = s.chosen[v];
+          std::memcpy(px + 4 * v, &colour[m], 4);
+          ++histogram[m];
+        }
+        lap(t, s.seconds[3]);
       }
     }
+    std::copy_n(histogram.begin(), nmat, out.counts.begin());
     out.png = encode_png_rgba(s.rgba.data(), nx, ny, cfg.dpi_x, cfg.dpi_y);
+    out.sha256 = sha256_hex(out.png);
+    lap(t, s.seconds[4]);
     return out;
   };
 
@@ -179,48 +284,82 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       static_cast<std::size_t>(tokens),
       tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
                                   [&](tbb::flow_control& fc) {
-                                    if (next >= nz) {
+                                    if (next >= todo.size()) {
                                       fc.stop();
                                       return 0;
                                     }
-                                    return next++;
+                                    return todo[next++];
                                   }) &
           tbb::make_filter<int, LayerOut>(tbb::filter_mode::parallel, sample_layer) &
           tbb::make_filter<LayerOut, void>(tbb::filter_mode::serial_in_order, [&](LayerOut out) {
-            write_file_atomically(opt.out_dir / cfg.slice_name(out.layer), out.png);
-            for (int m = 0; m < nmat; ++m) totals[static_cast<std::size_t>(m)] += out.counts[static_cast<std::size_t>(m)];
-            failures += out.failures;
+            const std::string name = cfg.slice_name(out.layer);
+            write_file_atomically(opt.out_dir / name, out.png, Durability::deferred);
+            finished[out.layer] = ManifestLayer{out.layer, name, out.sha256, out.counts, out.failures};
             ++done;
+            if (std::chrono::duration<double>(Clock::now() - last_manifest).count() >= opt.manifest_interval_s) {
+              write_manifest(false);
+              last_manifest = Clock::now();
+            }
             if (progress)
-              progress(done, nz, static_cast<std::int64_t>(done) * grid.voxels_per_layer(),
+              progress(done, total_layers, static_cast<std::int64_t>(done) * grid.voxels_per_layer(),
                        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
           }));
 
+  std::vector<std::int64_t> totals(static_cast<std::size_t>(nmat), 0);
+  std::int64_t failures = 0;
+  for (const auto& [k, l] : finished) {
+    for (int m = 0; m < nmat; ++m) totals[static_cast<std::size_t>(m)] += l.voxels[static_cast<std::size_t>(m)];
+    failures += l.failures;
+  }
   SliceJobSummary sum;
   sum.grid = grid;
-  sum.voxels = grid.voxels();
+  sum.voxels = static_cast<std::int64_t>(total_layers) * grid.voxels_per_layer();
   sum.inversion_failures = failures;
   sum.material_voxels = totals;
   sum.voxel_volume_mm3 = grid.pitch[0] * grid.pitch[1] * grid.pitch[2];
   sum.mapping = mapper.describe();
+  sum.layers_kept = kept;
+  sum.layer_range = manifest.layer_range;
+  sum.shard = opt.shard;
+  for (const Scratch& s : scratch)
+    for (std::size_t i = 0; i < s.seconds.size(); ++i) sum.stage_seconds[i] += s.seconds[i];
   for (int m = 0; m < nmat; ++m) {
     const auto& mat = palette.materials[static_cast<std::size_t>(m)];
     sum.materials.push_back(mat.name);
     sum.colours.push_back(mat.rgba);
     sum.filled += totals[static_cast<std::size_t>(m)];
-    cfg.materials.push_back({mat.name, mat.rgba, totals[static_cast<std::size_t>(m)]});
   }
-  // Last: the configuration that makes the folder a complete stack.
-  write_file_atomically(opt.out_dir / "ConfigFile.xml", config_xml(cfg));
-  if (opt.zip) {
-    fs::path zip = opt.out_dir;
-    if (!zip.has_filename()) zip = zip.parent_path();
-    zip += ".gcvf";
-    zip_stack(opt.out_dir, zip);
-    sum.zip_file = zip;
+  cfg = stack_config_of(manifest, totals);
+  if (opt.shard.count == 1) {
+    // The configuration that makes the folder a complete stack, once every layer is on disk.
+    sync_folder_contents(opt.out_dir);
+    const std::string config = config_xml(cfg);
+    write_file_atomically(opt.out_dir / "ConfigFile.xml", config);
+    manifest.files.push_back({"config", "ConfigFile.xml", sha256_hex(config)});
+    if (opt.zip) {
+      fs::path zip = opt.out_dir;
+      if (!zip.has_filename()) zip = zip.parent_path();
+      zip += ".gcvf";
+      zip_stack(opt.out_dir, zip);
+      sum.zip_file = zip;
+      manifest.files.push_back({"zip", "../" + zip.filename().string(), sha256_file(zip)});
+    }
   }
+  write_manifest(opt.last_output);
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sum;
+}
+
+void finish_manifest(const fs::path& dir, const Shard& shard, const std::vector<ManifestFile>& files) {
+  auto m = read_manifest(dir, shard.manifest_name());
+  if (!m)
+    throw Error((dir / shard.manifest_name()).string() + ": missing; expected the manifest of the job being finished");
+  for (const auto& f : files) {
+    std::erase_if(m->files, [&](const ManifestFile& g) { return g.role == f.role; });
+    m->files.push_back(f);
+  }
+  m->complete = true;
+  write_file_atomically(dir / shard.manifest_name(), manifest_json(*m));
 }
 
 }  // namespace trivox::io

@@ -44,9 +44,23 @@ void save_model(const vmodel::VModel& model, const std::filesystem::path& path);
 /// @throws trivox::Error (bad_input) "<path>: no such file; expected ..." and similar
 std::string read_file(const std::filesystem::path& path);
 
-/// Writes `bytes` to `path` through a temporary file in the same folder and a rename, after
-/// fsync: the file at `path` is either the old one or the complete new one.
+/// When a written file reaches the disk.
+enum class Durability {
+  synced,   ///< fsync of the file and its folder before returning
+  deferred  ///< left to the system, or to a later sync_folder_contents (many files of one job)
+};
+
+/// Writes `bytes` to `path` through a temporary file in the same folder and a rename: the file
+/// at `path` is either the old one or the complete new one. With Durability::synced (the
+/// default) also after a crash of the machine; with deferred, only once the caller has called
+/// sync_folder_contents (a job writes its layers deferred, syncs once, and then writes the file
+/// that marks the job complete synced).
 /// @throws trivox::Error (bad_input) naming the path and the system's reason
-void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
+                           Durability durability = Durability::synced);
+
+/// Flushes every file written so far in the file system that holds `dir` (syncfs).
+/// @throws trivox::Error (failed) naming the folder when the system reports a write error
+void sync_folder_contents(const std::filesystem::path& dir);
 
 }  // namespace trivox::io

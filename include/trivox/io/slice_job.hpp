@@ -6,7 +6,10 @@
 /// by band (slice::LayerSampler), mapped to material fractions (slice::MaterialMapper), dithered
 /// (slice::LayerDitherer), painted in palette colours and encoded to PNG in memory; an in-order
 /// stage writes each slice to a temporary name and renames it. ConfigFile.xml is written last,
-/// so an interrupted job never looks complete. Memory: per worker one layer of RGBA pixels
+/// after a sync, so an interrupted job never looks complete. The manifest (manifest.hpp) is
+/// rewritten every few seconds after a sync; it lets a killed job resume (`resume`: listed layers
+/// whose SHA-256 still matches are kept) and a job run as shards (`shard`: a range of whole
+/// 8-layer blocks, merged by merge_job). Memory: per worker one layer of RGBA pixels
 /// (width x height x 4 bytes) plus one band of samples; it does not grow with the layer count.
 /// Output is byte-identical for any thread count (every layer depends on its own inputs only).
 /// Masalha, Cirillo & Elber 2021, Sec. 8 (slicing for VoxelPrint).
@@ -15,10 +18,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "trivox/io/manifest.hpp"
 #include "trivox/slice/grid.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
@@ -34,6 +39,19 @@ struct SliceJobOptions {
   bool zip = false;                            ///< also pack the folder as <out_dir>.gcvf
   std::int64_t max_voxels = 100'000'000'000;   ///< refuse larger grids unless force
   int band_rows = 64;                          ///< rows sampled and dithered at a time
+
+  // The manifest (manifest.hpp): what identifies the job, resuming, sharding.
+  std::string model_file;                      ///< the model file's name, as given
+  std::string model_sha256;                    ///< of the model file's bytes ("" : not known)
+  /// Options of other outputs of the same job (the VDB's, say): part of the job's identity, so
+  /// that resuming with other values is refused.
+  std::map<std::string, std::string> extra_options;
+  bool resume = false;                         ///< keep the layers the manifest lists and that verify
+  Shard shard;                                 ///< slice only this shard's layers ({0, 1}: all)
+  /// Whether this call finishes the job: false when another output (the VDB) follows and will
+  /// call finish_manifest; until then the manifest says complete: false.
+  bool last_output = true;
+  double manifest_interval_s = 2.0;            ///< rewrite the manifest at most this often
 };
 
 /// What a job did, for the summary.
@@ -49,7 +67,17 @@ struct SliceJobSummary {
   double voxel_volume_mm3 = 0.0;
   std::string mapping;                   ///< how properties drive materials
   std::filesystem::path zip_file;        ///< set when zip was asked for
+  /// Thread-seconds spent per stage, summed over workers: sample (locate + evaluate), map
+  /// (properties to fractions), dither, paint (material indices to RGBA and counts), encode (PNG).
+  /// Writing is the remainder. For benchmarks and `--json`; not part of any output file.
+  std::array<double, 5> stage_seconds{};
+  int layers_kept = 0;                   ///< layers a resumed job found done and verified
+  std::array<int, 2> layer_range{};      ///< the layers this job (shard) covers, [first, end)
+  Shard shard;
 };
+
+/// Names of SliceJobSummary::stage_seconds, in order.
+inline constexpr std::array<const char*, 5> slice_stage_names{"sample", "map", "dither", "paint", "encode"};
 
 /// Progress reports: layers done of total, voxels done, seconds since the start.
 using SliceProgress = std::function<void(int layers_done, int layers_total, std::int64_t voxels_done, double seconds)>;
@@ -57,6 +85,11 @@ using SliceProgress = std::function<void(int layers_done, int layers_total, std:
 /// The grid the job would use for `model` (for size checks and `--dry-run`-like reports).
 /// @throws Error (bad_input) for an empty model or a degenerate box
 slice::VoxelGrid slice_grid(const vmodel::VModel& model, const slice::PrintProfile& profile);
+
+/// Marks the manifest of the job in `dir` (shard `shard`) complete, adding `files` (replacing
+/// entries of the same role): the last step of a job whose outputs were written by several calls.
+/// @throws Error (bad_input) when the manifest is missing or malformed; (failed) when writing fails
+void finish_manifest(const std::filesystem::path& dir, const Shard& shard, const std::vector<ManifestFile>& files);
 
 /// Runs the job. @throws Error (bad_input) for bad options, an unusable output folder, a job
 /// larger than the tray or max_voxels (unless force), a malformed palette; (failed) when writing

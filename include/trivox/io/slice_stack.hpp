@@ -13,8 +13,8 @@
 /// `buildGCVF.js`, read back by jackcrane/voxelprint-preview `parseGCVF.js`).
 ///
 /// Every file is written under a temporary name in the target folder and renamed into place
-/// after fsync (model_file.hpp `write_file_atomically`): a reader never finds a partial file
-/// under a final name, even if trivox is killed mid-write.
+/// (model_file.hpp `write_file_atomically`): a reader never finds a partial file under a final
+/// name, even if trivox is killed mid-write.
 ///
 /// Cost: encoding is one zlib pass over the pixels (see encode_png_rgba for the level);
 /// inspection and previews decode the PNGs they read once, streaming rows: memory per thread is

@@ -1,0 +1,125 @@
+/// @file trivox/io/manifest.hpp
+/// @brief What a print job wrote, and from what: `DIR/manifest.json` (or one part per shard),
+/// which makes every job verifiable, resumable and splittable across machines.
+///
+/// A manifest names the job (trivox version, the model file's SHA-256, every option that changes
+/// the output, the grid) and lists, per finished layer, its file, SHA-256, voxels per material
+/// and inversion failures, plus the job's other files (VDB, ConfigFile.xml, .gcvf) with their
+/// SHA-256. docs/slice-output.md has the format. The job rewrites it atomically as layers
+/// complete (every few seconds, and at the end), always after the layers it lists are on disk,
+/// so after a kill it lists only complete layers.
+///
+/// Shards: job K of N (`--shard K/N`, or a scheduler's array index) slices a contiguous range of
+/// layers aligned on 8 layers (an OpenVDB leaf's depth) and writes `manifest.shard-K-of-N.json`;
+/// `trivox merge` checks the parts and writes `manifest.json`.
+///
+/// Cost: writing is linear in the layers; parsing likewise.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "trivox/io/slice_stack.hpp"
+
+namespace trivox::io {
+
+/// One finished layer.
+struct ManifestLayer {
+  int index = 0;                       ///< layer k (0 at the bottom)
+  std::string file;                    ///< its PNG's name in the folder
+  std::string sha256;                  ///< of the PNG's bytes
+  std::vector<std::int64_t> voxels;    ///< per palette material (Manifest::materials order)
+  std::int64_t failures = 0;           ///< inversion failures in the layer
+
+  bool operator==(const ManifestLayer&) const = default;
+};
+
+/// Another file of the job (VDB, ConfigFile.xml, the .gcvf zip).
+struct ManifestFile {
+  std::string role;    ///< "vdb", "config", "zip"
+  std::string file;    ///< name relative to the folder (the zip: relative to the folder's parent)
+  std::string sha256;
+
+  bool operator==(const ManifestFile&) const = default;
+};
+
+/// Which part of a job this process does: shard `index` of `count` (0 <= index < count).
+struct Shard {
+  int index = 0;
+  int count = 1;
+
+  bool operator==(const Shard&) const = default;
+  /// "manifest.json" for a whole job, "manifest.shard-K-of-N.json" for a shard.
+  std::string manifest_name() const;
+  /// A file name with ".shard-K-of-N" before the extension for a shard (model.vdb ->
+  /// model.shard-1-of-3.vdb), unchanged for a whole job.
+  std::string part_name(const std::string& name) const;
+  /// The layers [first, end) of `layers` this shard slices: contiguous ranges of whole blocks of
+  /// `align` layers (the last block may be short), split as evenly as blocks allow; a shard may
+  /// get none when there are fewer blocks than shards.
+  std::array<int, 2> range(int layers, int align = 8) const;
+};
+
+/// Parses "K/N" (0 <= K < N <= 100000).
+/// @throws Error (bad_input) naming `option` and the text
+Shard parse_shard(const std::string& text, const std::string& option = "--shard");
+
+/// The shard from a scheduler's environment when no --shard was given: Slurm job arrays
+/// (SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN of SLURM_ARRAY_TASK_COUNT), or a Kubernetes
+/// Indexed Job (JOB_COMPLETION_INDEX, with the count from `shard_count`, i.e. --shard-count).
+/// @param getenv  lookup of an environment variable (null when unset); std::getenv by default
+/// @return nothing when no scheduler variable is set
+/// @throws Error (bad_input) naming the variable for malformed or inconsistent values, or
+///         JOB_COMPLETION_INDEX without a shard count
+std::optional<Shard> shard_from_environment(std::optional<int> shard_count,
+                                            const char* (*getenv)(const char*) = nullptr);
+
+/// A job's manifest (or one shard's part of it).
+struct Manifest {
+  std::string trivox;                  ///< version that wrote it
+  std::string model_file;              ///< the model's file name (as given)
+  std::string model_sha256;            ///< of the model file's bytes
+  /// Every option that changes the outputs, as canonical strings (printer, dpi, layer, palette
+  /// name and SHA-256, dither, png, vdb, ...). Two jobs with equal identity write equal files.
+  std::map<std::string, std::string> options;
+  std::array<int, 3> grid{};           ///< voxels along x, y and layers
+  double dpi_x = 0.0, dpi_y = 0.0;     ///< the PNG stack's resolution
+  double layer_mm = 0.0;               ///< and layer thickness
+  std::vector<std::string> materials;  ///< palette material names, the order of voxel counts
+  std::vector<std::array<std::uint8_t, 4>> colours;  ///< their RGBA keys, same order
+  Shard shard;                         ///< which part this is ({0, 1}: the whole job)
+  std::array<int, 2> layer_range{};    ///< [first, end) of the layers this part slices
+  std::vector<ManifestLayer> layers;   ///< finished layers, ascending index
+  std::vector<ManifestFile> files;     ///< other outputs, once complete
+  bool complete = false;               ///< every layer of the range and every file is written
+
+  /// Same trivox version, model, options, grid and materials: outputs may be shared.
+  bool same_job(const Manifest& other) const;
+  /// The first difference from `other`'s identity, e.g. "the model's SHA-256 differs", or "".
+  std::string difference(const Manifest& other) const;
+  /// The layer k, or null.
+  const ManifestLayer* layer(int k) const;
+};
+
+/// The ConfigFile.xml of the job's PNG stack: resolution, size and palette from the manifest,
+/// with voxel counts `totals` (one per material).
+StackConfig stack_config_of(const Manifest& manifest, const std::vector<std::int64_t>& totals);
+
+/// The manifest as JSON text (2-space indented, keys in a fixed order, ending with a newline).
+std::string manifest_json(const Manifest& manifest);
+
+/// Parses a manifest.
+/// @param source  the file name, for messages
+/// @throws Error (bad_input) "<source>: <JSON pointer>: ...; expected ..." for anything malformed
+Manifest parse_manifest(std::string_view text, const std::string& source);
+
+/// Reads `dir / name` when it exists; nothing when it does not.
+/// @throws Error (bad_input) when it exists but cannot be read or parsed
+std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name);
+
+}  // namespace trivox::io

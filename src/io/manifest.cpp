@@ -1,0 +1,307 @@
+#include "trivox/io/manifest.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "../detail/json_text.hpp"
+#include "trivox/error.hpp"
+#include "trivox/io/model_file.hpp"
+
+namespace trivox::io {
+
+namespace {
+
+using ojson = nlohmann::ordered_json;
+using json = nlohmann::json;
+
+constexpr int manifest_version = 1;
+constexpr int max_shards = 100000;
+
+/// Typed access with "<source>: <pointer>: found ...; expected ..." messages.
+struct Reader {
+  const std::string& source;
+
+  [[noreturn]] void fail(const std::string& ptr, const std::string& what) const {
+    throw Error(source + ": " + (ptr.empty() ? std::string("top level") : ptr) + ": " + what);
+  }
+  [[noreturn]] void fail_type(const std::string& ptr, const json& j, const std::string& expected) const {
+    fail(ptr, "found " + detail::json_describe(j) + "; expected " + expected);
+  }
+  const json& member(const json& obj, const std::string& ptr, const char* key) const {
+    const auto it = obj.find(key);
+    if (it == obj.end()) fail(ptr, std::string("no \"") + key + "\"; expected one");
+    return *it;
+  }
+  std::string string(const json& j, const std::string& ptr) const {
+    if (!j.is_string()) fail_type(ptr, j, "a string");
+    return j.get<std::string>();
+  }
+  std::string sha(const json& j, const std::string& ptr) const {
+    const std::string s = string(j, ptr);
+    const bool hex = s.size() == 64 && std::all_of(s.begin(), s.end(), [](char c) {
+                       return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+                     });
+    if (!hex) fail_type(ptr, j, "a SHA-256 digest (64 lowercase hex digits)");
+    return s;
+  }
+  std::int64_t integer(const json& j, const std::string& ptr, std::int64_t lo, std::int64_t hi) const {
+    if (!j.is_number_integer() && !j.is_number_unsigned())
+      fail_type(ptr, j, "an integer from " + std::to_string(lo) + " to " + std::to_string(hi));
+    if (j.is_number_unsigned() && j.get<std::uint64_t>() > static_cast<std::uint64_t>(hi))
+      fail_type(ptr, j, "an integer from " + std::to_string(lo) + " to " + std::to_string(hi));
+    const auto v = j.get<std::int64_t>();
+    if (v < lo || v > hi) fail_type(ptr, j, "an integer from " + std::to_string(lo) + " to " + std::to_string(hi));
+    return v;
+  }
+  const json& array(const json& j, const std::string& ptr, const std::string& of) const {
+    if (!j.is_array()) fail_type(ptr, j, "an array of " + of);
+    return j;
+  }
+};
+
+std::string shard_suffix(const Shard& s) {
+  return ".shard-" + std::to_string(s.index) + "-of-" + std::to_string(s.count);
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------
+// Shards
+
+std::string Shard::manifest_name() const { return part_name("manifest.json"); }
+
+std::string Shard::part_name(const std::string& name) const {
+  if (count == 1) return name;
+  const auto dot = name.rfind('.');
+  if (dot == std::string::npos || dot == 0) return name + shard_suffix(*this);
+  return name.substr(0, dot) + shard_suffix(*this) + name.substr(dot);
+}
+
+std::array<int, 2> Shard::range(int layers, int align) const {
+  const long blocks = (static_cast<long>(layers) + align - 1) / align;
+  const long b0 = blocks * index / count, b1 = blocks * (index + 1) / count;
+  return {static_cast<int>(std::min<long>(layers, b0 * align)), static_cast<int>(std::min<long>(layers, b1 * align))};
+}
+
+Shard parse_shard(const std::string& text, const std::string& option) {
+  const auto bad = [&]() -> Error {
+    return Error(option + " " + text + ": expected K/N with 0 <= K < N <= " + std::to_string(max_shards) +
+                 " (shard K counts from 0: 0/3, 1/3, 2/3)");
+  };
+  const auto slash = text.find('/');
+  if (slash == std::string::npos) throw bad();
+  auto number = [&](const std::string& s) {
+    if (s.empty() || s.size() > 6 || !std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; }))
+      throw bad();
+    return std::stoi(s);
+  };
+  const int k = number(text.substr(0, slash)), n = number(text.substr(slash + 1));
+  if (n < 1 || n > max_shards || k >= n) throw bad();
+  return {k, n};
+}
+
+std::optional<Shard> shard_from_environment(std::optional<int> shard_count, const char* (*getenv)(const char*)) {
+  const auto get = [&](const char* name) -> const char* {
+    if (getenv) return getenv(name);
+    return std::getenv(name);
+  };
+  const auto integer = [&](const char* name, long lo, long hi) -> std::optional<long> {
+    const char* v = get(name);
+    if (!v) return std::nullopt;
+    const std::string s = v;
+    const bool digits = !s.empty() && s.size() <= 9 && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+    if (!digits || std::stol(s) < lo || std::stol(s) > hi)
+      throw Error(std::string("environment variable ") + name + "=\"" + s + "\": expected an integer from " +
+                  std::to_string(lo) + " to " + std::to_string(hi));
+    return std::stol(s);
+  };
+  if (shard_count && (*shard_count < 1 || *shard_count > max_shards))
+    throw Error("--shard-count " + std::to_string(*shard_count) + ": expected 1 to " + std::to_string(max_shards));
+  if (const auto id = integer("SLURM_ARRAY_TASK_ID", 0, 999999999)) {
+    const auto count = integer("SLURM_ARRAY_TASK_COUNT", 1, max_shards);
+    const auto min = integer("SLURM_ARRAY_TASK_MIN", 0, 999999999);
+    if (!count)
+      throw Error("SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; expected both (a Slurm job "
+                  "array), or --shard K/N");
+    const long k = *id - min.value_or(0);
+    if (k < 0 || k >= *count)
+      throw Error("SLURM_ARRAY_TASK_ID " + std::to_string(*id) + " minus SLURM_ARRAY_TASK_MIN " +
+                  std::to_string(min.value_or(0)) + " is " + std::to_string(k) + "; expected 0 to " +
+                  std::to_string(*count - 1) + " (an array of consecutive task ids; otherwise use --shard K/N)");
+    return Shard{static_cast<int>(k), static_cast<int>(*count)};
+  }
+  if (const auto index = integer("JOB_COMPLETION_INDEX", 0, max_shards - 1)) {
+    if (!shard_count)
+      throw Error("JOB_COMPLETION_INDEX=" + std::to_string(*index) +
+                  " (a Kubernetes Indexed Job) needs the job's completions; expected --shard-count N");
+    if (*index >= *shard_count)
+      throw Error("JOB_COMPLETION_INDEX " + std::to_string(*index) + ": expected 0 to " +
+                  std::to_string(*shard_count - 1) + " for --shard-count " + std::to_string(*shard_count));
+    return Shard{static_cast<int>(*index), *shard_count};
+  }
+  return std::nullopt;
+}
+
+// ------------------------------------------------------------------------------------------
+// Manifest
+
+bool Manifest::same_job(const Manifest& o) const { return difference(o).empty(); }
+
+std::string Manifest::difference(const Manifest& o) const {
+  if (trivox != o.trivox) return "it was written by trivox " + o.trivox + ", this is trivox " + trivox;
+  if (model_sha256 != o.model_sha256) return "the model's SHA-256 differs (" + o.model_file + " then, " + model_file + " now)";
+  for (const auto& [k, v] : options) {
+    const auto it = o.options.find(k);
+    if (it == o.options.end()) return "option " + k + " was not set then";
+    if (it->second != v) return "option " + k + " was " + it->second + ", now " + v;
+  }
+  for (const auto& [k, v] : o.options)
+    if (!options.count(k)) return "option " + k + " was " + v + " then, and is not set now";
+  if (grid != o.grid) return "the voxel grid differs";
+  if (materials != o.materials || colours != o.colours) return "the palette's materials differ";
+  return {};
+}
+
+const ManifestLayer* Manifest::layer(int k) const {
+  const auto it = std::lower_bound(layers.begin(), layers.end(), k, [](const ManifestLayer& l, int v) { return l.index < v; });
+  return it != layers.end() && it->index == k ? &*it : nullptr;
+}
+
+StackConfig stack_config_of(const Manifest& m, const std::vector<std::int64_t>& totals) {
+  StackConfig cfg;
+  cfg.dpi_x = m.dpi_x;
+  cfg.dpi_y = m.dpi_y;
+  cfg.slice_thickness_nm = m.layer_mm * 1e6;
+  cfg.width = m.grid[0];
+  cfg.height = m.grid[1];
+  cfg.slices = m.grid[2];
+  cfg.digits = std::max(5, static_cast<int>(std::to_string(m.grid[2]).size()));
+  for (std::size_t i = 0; i < m.materials.size(); ++i)
+    cfg.materials.push_back({m.materials[i], i < m.colours.size() ? m.colours[i] : std::array<std::uint8_t, 4>{},
+                             i < totals.size() ? totals[i] : 0});
+  return cfg;
+}
+
+std::string manifest_json(const Manifest& m) {
+  ojson j;
+  j["trivox_manifest"] = manifest_version;
+  j["trivox"] = m.trivox;
+  j["model"] = {{"file", m.model_file}, {"sha256", m.model_sha256}};
+  ojson opts = ojson::object();
+  for (const auto& [k, v] : m.options) opts[k] = v;
+  j["options"] = opts;
+  j["grid"] = m.grid;
+  j["print"] = {{"dpi", {m.dpi_x, m.dpi_y}}, {"layer_mm", m.layer_mm}};
+  ojson mats = ojson::array();
+  for (std::size_t i = 0; i < m.materials.size(); ++i)
+    mats.push_back({{"name", m.materials[i]}, {"rgba", i < m.colours.size() ? m.colours[i] : std::array<std::uint8_t, 4>{}}});
+  j["materials"] = mats;
+  j["shard"] = {{"index", m.shard.index}, {"count", m.shard.count}};
+  j["layer_range"] = m.layer_range;
+  j["complete"] = m.complete;
+  ojson files = ojson::array();
+  for (const auto& f : m.files) files.push_back({{"role", f.role}, {"file", f.file}, {"sha256", f.sha256}});
+  j["files"] = files;
+  ojson layers = ojson::array();
+  for (const auto& l : m.layers)
+    layers.push_back({{"index", l.index}, {"file", l.file}, {"sha256", l.sha256}, {"voxels", l.voxels}, {"failures", l.failures}});
+  j["layers"] = layers;
+  std::string text = j.dump(2);
+  text += '\n';
+  return text;
+}
+
+Manifest parse_manifest(std::string_view text, const std::string& source) {
+  const json root = detail::parse_json_text(text, source);
+  const Reader r{source};
+  if (!root.is_object()) r.fail_type("", root, "an object {\"trivox_manifest\": 1, ...}");
+  const auto& ver = r.member(root, "", "trivox_manifest");
+  if (r.integer(ver, "/trivox_manifest", 0, 1000000) != manifest_version)
+    r.fail_type("/trivox_manifest", ver, "1 (a newer trivox wrote this file?)");
+  Manifest m;
+  m.trivox = r.string(r.member(root, "", "trivox"), "/trivox");
+  const auto& model = r.member(root, "", "model");
+  if (!model.is_object()) r.fail_type("/model", model, "an object {\"file\", \"sha256\"}");
+  m.model_file = r.string(r.member(model, "/model", "file"), "/model/file");
+  m.model_sha256 = r.sha(r.member(model, "/model", "sha256"), "/model/sha256");
+  const auto& opts = r.member(root, "", "options");
+  if (!opts.is_object()) r.fail_type("/options", opts, "an object of strings");
+  for (const auto& [k, v] : opts.items()) m.options[k] = r.string(v, "/options/" + k);
+  const auto& grid = r.array(r.member(root, "", "grid"), "/grid", "3 voxel counts");
+  if (grid.size() != 3) r.fail_type("/grid", grid, "an array of 3 voxel counts");
+  for (std::size_t d = 0; d < 3; ++d)
+    m.grid[d] = static_cast<int>(r.integer(grid[d], "/grid/" + std::to_string(d), 1, 2147483647));
+  const auto& print = r.member(root, "", "print");
+  if (!print.is_object()) r.fail_type("/print", print, "an object {\"dpi\": [x, y], \"layer_mm\"}");
+  const auto& dpi = r.array(r.member(print, "/print", "dpi"), "/print/dpi", "2 numbers");
+  if (dpi.size() != 2 || !dpi[0].is_number() || !dpi[1].is_number()) r.fail_type("/print/dpi", dpi, "an array of 2 numbers");
+  m.dpi_x = dpi[0].get<double>();
+  m.dpi_y = dpi[1].get<double>();
+  const auto& layer = r.member(print, "/print", "layer_mm");
+  if (!layer.is_number()) r.fail_type("/print/layer_mm", layer, "a number");
+  m.layer_mm = layer.get<double>();
+  const auto& mats = r.array(r.member(root, "", "materials"), "/materials", "materials");
+  for (std::size_t i = 0; i < mats.size(); ++i) {
+    const std::string p = "/materials/" + std::to_string(i);
+    if (!mats[i].is_object()) r.fail_type(p, mats[i], "an object {\"name\", \"rgba\"}");
+    m.materials.push_back(r.string(r.member(mats[i], p, "name"), p + "/name"));
+    const auto& c = r.array(r.member(mats[i], p, "rgba"), p + "/rgba", "4 integers 0..255");
+    if (c.size() != 4) r.fail_type(p + "/rgba", c, "an array of 4 integers 0..255");
+    std::array<std::uint8_t, 4> rgba{};
+    for (std::size_t k = 0; k < 4; ++k)
+      rgba[k] = static_cast<std::uint8_t>(r.integer(c[k], p + "/rgba/" + std::to_string(k), 0, 255));
+    m.colours.push_back(rgba);
+  }
+  const auto& shard = r.member(root, "", "shard");
+  if (!shard.is_object()) r.fail_type("/shard", shard, "an object {\"index\", \"count\"}");
+  m.shard.count = static_cast<int>(r.integer(r.member(shard, "/shard", "count"), "/shard/count", 1, max_shards));
+  m.shard.index = static_cast<int>(r.integer(r.member(shard, "/shard", "index"), "/shard/index", 0, m.shard.count - 1));
+  const auto& range = r.array(r.member(root, "", "layer_range"), "/layer_range", "2 layer indices");
+  if (range.size() != 2) r.fail_type("/layer_range", range, "an array of 2 layer indices [first, end)");
+  m.layer_range[0] = static_cast<int>(r.integer(range[0], "/layer_range/0", 0, m.grid[2]));
+  m.layer_range[1] = static_cast<int>(r.integer(range[1], "/layer_range/1", m.layer_range[0], m.grid[2]));
+  const auto& complete = r.member(root, "", "complete");
+  if (!complete.is_boolean()) r.fail_type("/complete", complete, "true or false");
+  m.complete = complete.get<bool>();
+  const auto& files = r.array(r.member(root, "", "files"), "/files", "files");
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::string p = "/files/" + std::to_string(i);
+    if (!files[i].is_object()) r.fail_type(p, files[i], "an object {\"role\", \"file\", \"sha256\"}");
+    m.files.push_back({r.string(r.member(files[i], p, "role"), p + "/role"), r.string(r.member(files[i], p, "file"), p + "/file"),
+                       r.sha(r.member(files[i], p, "sha256"), p + "/sha256")});
+  }
+  const auto& layers = r.array(r.member(root, "", "layers"), "/layers", "layers");
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const std::string p = "/layers/" + std::to_string(i);
+    const json& l = layers[i];
+    if (!l.is_object()) r.fail_type(p, l, "an object {\"index\", \"file\", \"sha256\", \"voxels\", \"failures\"}");
+    ManifestLayer ml;
+    ml.index = static_cast<int>(r.integer(r.member(l, p, "index"), p + "/index", m.layer_range[0], m.layer_range[1] - 1));
+    if (!m.layers.empty() && ml.index <= m.layers.back().index)
+      r.fail_type(p + "/index", l["index"], "layers in ascending order, each once");
+    ml.file = r.string(r.member(l, p, "file"), p + "/file");
+    if (ml.file.empty() || ml.file.find('/') != std::string::npos || ml.file.find('\\') != std::string::npos ||
+        ml.file == "." || ml.file == "..")
+      r.fail_type(p + "/file", l["file"], "a file name inside the folder");
+    ml.sha256 = r.sha(r.member(l, p, "sha256"), p + "/sha256");
+    const auto& vox = r.array(r.member(l, p, "voxels"), p + "/voxels", "voxel counts");
+    if (vox.size() != m.materials.size())
+      r.fail_type(p + "/voxels", vox, "one count per material (" + std::to_string(m.materials.size()) + ")");
+    for (std::size_t k = 0; k < vox.size(); ++k)
+      ml.voxels.push_back(r.integer(vox[k], p + "/voxels/" + std::to_string(k), 0, std::int64_t{1} << 53));
+    ml.failures = r.integer(r.member(l, p, "failures"), p + "/failures", 0, std::int64_t{1} << 53);
+    m.layers.push_back(std::move(ml));
+  }
+  return m;
+}
+
+std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name) {
+  const auto path = dir / name;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return std::nullopt;
+  return parse_manifest(read_file(path), path.string());
+}
+
+}  // namespace trivox::io

@@ -1,0 +1,664 @@
+#include "trivox/io/vdb_job.hpp"
+
+#include <openvdb/io/Archive.h>
+#include <openvdb/io/Stream.h>
+#include <openvdb/openvdb.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <system_error>
+
+#include "trivox/error.hpp"
+#include "trivox/geom/quadrature.hpp"
+#include "trivox/io/merge.hpp"
+#include "trivox/io/model_file.hpp"
+#include "trivox/io/sha256.hpp"
+#include "trivox/slice/locator.hpp"
+#include "trivox/slice/material.hpp"
+#include "trivox/slice/sampler.hpp"
+#include "trivox/version.hpp"
+
+namespace trivox::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int leaf_dim = 8;                      // OpenVDB leaf nodes are 8^3 voxels
+constexpr double max_axis = 1073741824.0;        // 2^30 sub-samples along an axis
+constexpr std::int64_t task_voxels = 1 << 18;    // voxels of one task (dense sums)
+constexpr std::int64_t task_samples = 1 << 22;   // sub-samples of one task
+constexpr int sample_rows = 32;                  // fine rows per sampler call (multiple of 4)
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+/// The smallest d x 10^e (d with two significant digits) >= v.
+double round_up_2_digits(double v) {
+  const int e = static_cast<int>(std::floor(std::log10(v))) - 1;
+  const double scale = std::pow(10.0, std::abs(e));
+  double m = std::ceil(e < 0 ? v * scale * (1 - 1e-12) : v / scale * (1 - 1e-12));
+  auto value = [&](double mm) { return e < 0 ? mm / scale : mm * scale; };
+  while (value(m) < v) m += 1.0;
+  return value(m);
+}
+
+/// The folder: created, or (when asked) empty unless force; writable.
+void prepare_folder(const fs::path& dir, bool require_empty, bool force) {
+  std::error_code ec;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec))
+      throw Error(dir.string() + ": exists and is not a folder; expected a new or empty folder for the output");
+    if (require_empty && !force && fs::directory_iterator(dir, ec) != fs::directory_iterator())
+      throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (or --force to overwrite)");
+  } else if (!fs::create_directories(dir, ec) || ec) {
+    throw Error(dir.string() + ": cannot create the folder (" + ec.message() + "); expected a writable location");
+  }
+  const fs::path probe = dir / ".trivox-write-test";
+  try {
+    write_file_atomically(probe, "");
+  } catch (const Error&) {
+    throw Error(dir.string() + ": the folder is not writable; expected a writable folder");
+  }
+  fs::remove(probe, ec);
+}
+
+/// What the grids are made of: names, and which properties feed which grid.
+struct Layout {
+  int nprops = 0, nmat = 0;
+  bool rgb = false;
+  std::array<int, 3> rgb_props{};           // indices of r, g, b
+  std::vector<int> extra_props;             // properties with a grid of their own
+  std::vector<std::string> extra_names;     // their grid names
+  std::vector<std::array<float, 3>> material_rgb;  // palette RGB / 255
+};
+
+Layout make_layout(const vmodel::VModel& model, const slice::Palette& palette) {
+  Layout l;
+  l.nprops = static_cast<int>(model.properties.size());
+  l.nmat = static_cast<int>(palette.materials.size());
+  std::array<int, 3> found{-1, -1, -1};
+  for (int p = 0; p < l.nprops; ++p) {
+    const std::string& n = model.properties[static_cast<std::size_t>(p)];
+    if (n == "r") found[0] = p;
+    if (n == "g") found[1] = p;
+    if (n == "b") found[2] = p;
+  }
+  l.rgb = found[0] >= 0 && found[1] >= 0 && found[2] >= 0;
+  if (l.rgb) l.rgb_props = found;
+  for (int p = 0; p < l.nprops; ++p) {
+    const std::string& n = model.properties[static_cast<std::size_t>(p)];
+    if (l.rgb && (p == found[0] || p == found[1] || p == found[2])) continue;
+    if (palette.find(n) >= 0) continue;
+    const bool taken = n == "density" || n == "color" || n == "Cd" || n.rfind("material.", 0) == 0 ||
+                       n.rfind("property.", 0) == 0;
+    l.extra_props.push_back(p);
+    l.extra_names.push_back(taken ? "property." + n : n);
+  }
+  for (const auto& m : palette.materials)
+    l.material_rgb.push_back({m.rgba[0] / 255.0f, m.rgba[1] / 255.0f, m.rgba[2] / 255.0f});
+  return l;
+}
+
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+using Vec3Leaf = openvdb::Vec3STree::LeafNodeType;
+
+/// One task's output: its own trees (disjoint from every other task's) and sums.
+struct TaskOut {
+  int index = -1;
+  openvdb::FloatTree::Ptr density;
+  openvdb::Vec3STree::Ptr color;
+  std::vector<openvdb::FloatTree::Ptr> materials, extras;
+  std::int64_t active = 0, fractional = 0, failures = 0, samples = 0;
+  double density_sum = 0.0;               // sum of density
+  std::vector<double> material_sum;       // sum of fraction x density
+};
+
+/// Per-worker scratch, reused across tasks.
+struct Scratch {
+  slice::RowBand band;
+  std::vector<std::int32_t> count;   // inside sub-samples per voxel
+  std::vector<double> sums;          // per voxel: nprops property sums, then nmat fraction sums
+  std::vector<float> fractions;
+};
+
+/// The random UUID OpenVDB writes into every header, replaced by one derived from the file.
+/// Header: magic (8 bytes), file format (4), library major and minor (4 + 4), grid offsets
+/// flag (1), then the UUID as 36 characters (Archive::writeHeader).
+constexpr std::size_t uuid_offset = 21, uuid_size = 36;
+
+constexpr char zero_uuid[] = "00000000-0000-0000-0000-000000000000";
+
+bool looks_like_uuid(std::string_view u) {
+  if (u.size() != uuid_size) return false;
+  for (std::size_t i = 0; i < uuid_size; ++i) {
+    const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
+    if (dash ? u[i] != '-' : !std::isxdigit(static_cast<unsigned char>(u[i]))) return false;
+  }
+  return true;
+}
+
+/// The first 128 bits of a SHA-256 digest (hex) as an RFC 9562 version 8 (custom) UUID.
+std::string uuid_from_digest(const std::string& h) {
+  std::string u;
+  for (int i = 0; i < 16; ++i) {
+    int byte = std::stoi(h.substr(static_cast<std::size_t>(2 * i), 2), nullptr, 16);
+    if (i == 6) byte = (byte & 0x0f) | 0x80;
+    if (i == 8) byte = (byte & 0x3f) | 0x80;
+    char buf[3];
+    std::snprintf(buf, sizeof buf, "%02x", byte);
+    u += buf;
+    if (i == 3 || i == 5 || i == 7 || i == 9) u += '-';
+  }
+  return u;
+}
+
+/// Archive::write into any seekable stream: what File::write does into its own ofstream.
+class StreamArchive : public openvdb::io::Archive {
+public:
+  void write_to(std::ostream& os, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta) const {
+    Archive::write(os, grids, /*seekable=*/true, meta);
+  }
+};
+
+std::string reason(int err) { return std::strerror(err); }
+
+/// Removes a temporary file unless released.
+struct TempFile {
+  fs::path path;
+  bool keep = false;
+  ~TempFile() {
+    std::error_code ec;
+    if (!keep && !path.empty()) fs::remove(path, ec);
+  }
+};
+
+/// Writes the grids to `path` through a temporary file in the same folder (`.<name>.tmp-<pid>-<n>`):
+/// OpenVDB streams the file there, its random UUID is replaced in place by one derived from the
+/// SHA-256 of the file with the UUID zeroed, then fsync and a rename over `path`. A reader never
+/// sees a partial file; memory stays that of the grids. Returns the size and the SHA-256 of the
+/// written file.
+std::pair<std::int64_t, std::string> write_vdb_file(const fs::path& path, const openvdb::GridCPtrVec& grids,
+                                                    const openvdb::MetaMap& meta) {
+  auto fail = [&](const std::string& what, int err) {
+    throw Error(path.string() + ": " + what + " (" + reason(err) + "); expected a writable folder with room for the file");
+  };
+  TempFile tmp;
+  for (int attempt = 0; attempt < 100 && tmp.path.empty(); ++attempt) {
+    const fs::path name = path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) +
+                                                "-" + std::to_string(attempt));
+    const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      ::close(fd);
+      tmp.path = name;
+    } else if (errno != EEXIST) {
+      fail("cannot create a temporary file", errno);
+    }
+  }
+  if (tmp.path.empty()) fail("cannot create a temporary file", EEXIST);
+  {
+    std::ofstream os(tmp.path, std::ios::binary | std::ios::trunc);
+    if (!os) fail("cannot open the temporary file", errno);
+    try {
+      StreamArchive().write_to(os, grids, meta);
+    } catch (const openvdb::Exception& e) {
+      throw Error(path.string() + ": OpenVDB could not write the grids: " + e.what(), ErrorKind::failed);
+    }
+    os.flush();
+    if (!os) fail("writing failed", errno);
+  }
+  // The UUID: zeroed, the file hashed, the derived UUID written in its place.
+  auto put_uuid = [&](std::string_view u) {
+    std::fstream f(tmp.path, std::ios::binary | std::ios::in | std::ios::out);
+    f.seekp(static_cast<std::streamoff>(uuid_offset));
+    f.write(u.data(), static_cast<std::streamsize>(u.size()));
+    f.flush();
+    if (!f) fail("cannot update the file header", errno);
+  };
+  {
+    std::ifstream in(tmp.path, std::ios::binary);
+    std::string head(uuid_offset + uuid_size, '\0');
+    if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) ||
+        !looks_like_uuid(std::string_view(head).substr(uuid_offset)))
+      throw Error(path.string() + ": OpenVDB wrote an unexpected header (no UUID at byte 21); expected the "
+                  "OpenVDB 10 file layout", ErrorKind::failed);
+  }
+  put_uuid(std::string_view(zero_uuid, uuid_size));
+  put_uuid(uuid_from_digest(sha256_file(tmp.path)));
+  const std::string digest = sha256_file(tmp.path);
+  const int fd = ::open(tmp.path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0 || ::fsync(fd) != 0) fail("cannot flush the file to disk", errno);
+  ::close(fd);
+  if (::rename(tmp.path.c_str(), path.c_str()) != 0) fail("cannot rename the temporary file into place", errno);
+  tmp.keep = true;
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  std::error_code ec;
+  return {static_cast<std::int64_t>(fs::file_size(path, ec)), digest};
+}
+
+}  // namespace
+
+VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
+  if (model.cells.empty())
+    throw Error("the model has no cells; expected at least one volumetric cell to sample");
+  if (opt.supersample < 1 || opt.supersample > 8)
+    throw Error("--supersample " + std::to_string(opt.supersample) + ": out of range; expected 1 to 8 (N^3 samples per voxel)");
+  if (opt.voxel_mm && !(std::isfinite(*opt.voxel_mm) && *opt.voxel_mm > 0.0))
+    throw Error("--vdb-voxel " + num(*opt.voxel_mm) + ": not a positive size; expected a voxel edge in mm, above 0");
+  VdbPlan plan;
+  plan.supersample = opt.supersample;
+  const auto box = slice::model_bounds(model);
+  plan.origin = box[0];
+
+  std::vector<double> volumes(model.cells.size());
+  tbb::parallel_for(std::size_t{0}, model.cells.size(),
+                    [&](std::size_t i) { volumes[i] = std::abs(geom::signed_volume(model.cells[i].volume)); });
+  for (double v : volumes) plan.estimated_volume_mm3 += v;
+
+  std::array<double, 3> extent{};
+  double box_volume = 1.0;
+  for (std::size_t d = 0; d < 3; ++d) {
+    extent[d] = box[1][d] - box[0][d];
+    box_volume *= std::max(extent[d], 0.0);
+  }
+  if (opt.voxel_mm) {
+    plan.voxel_mm = *opt.voxel_mm;
+  } else {
+    plan.automatic = true;
+    const double by_volume = std::cbrt(plan.estimated_volume_mm3 / static_cast<double>(opt.target_active_voxels));
+    const double by_box = std::cbrt(box_volume / static_cast<double>(opt.max_dense_voxels));
+    double v = std::max(by_volume, by_box);
+    if (!(v > 0.0) || !std::isfinite(v)) v = std::max({extent[0], extent[1], extent[2], 1e-3}) / 64.0;
+    plan.voxel_mm = round_up_2_digits(v);
+  }
+  const double vx = plan.voxel_mm;
+  double dense = 1.0;
+  static constexpr const char* axis = "xyz";
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double n = std::max(1.0, std::ceil(extent[d] / vx));
+    if (n * opt.supersample > max_axis)
+      throw Error("--vdb-voxel " + num(vx) + ": " + num(n) + " voxels along " + axis[d] + " (" + num(extent[d]) +
+                  " mm) with --supersample " + std::to_string(opt.supersample) + "; expected at most " +
+                  num(max_axis) + " sub-samples along an axis");
+    plan.count[d] = static_cast<int>(n);
+    dense *= n;
+  }
+  plan.dense_voxels = static_cast<std::int64_t>(dense);
+  plan.estimated_active_voxels = plan.estimated_volume_mm3 / (vx * vx * vx);
+  if (dense > static_cast<double>(opt.max_dense_voxels) && !opt.force)
+    throw Error("--vdb-voxel " + num(vx) + ": the box " + num(extent[0]) + " x " + num(extent[1]) + " x " +
+                num(extent[2]) + " mm needs " + std::to_string(plan.count[0]) + " x " + std::to_string(plan.count[1]) +
+                " x " + std::to_string(plan.count[2]) + " = " + num(dense) + " voxels; expected at most " +
+                num(static_cast<double>(opt.max_dense_voxels)) + " (a larger --vdb-voxel, or --force)");
+  if (opt.layer_range) {
+    const auto [first, end] = *opt.layer_range;
+    const int nz = plan.count[2];
+    if (first < 0 || first > end || end > nz || first % leaf_dim != 0 || (end % leaf_dim != 0 && end != nz))
+      throw Error("VDB layer range [" + std::to_string(first) + ", " + std::to_string(end) + ") of " +
+                  std::to_string(nz) + " layers; expected whole blocks of 8 layers (the end may be the last layer)");
+  }
+  const std::string stem = opt.model_file.empty() ? std::string("model") : opt.model_file.stem().string();
+  plan.file = opt.out_dir / (!opt.file_name.empty() ? opt.file_name : stem.empty() ? std::string("model.vdb") : stem + ".vdb");
+  return plan;
+}
+
+VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt, const VdbProgress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const VdbPlan plan = plan_vdb_job(model, opt);
+  const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
+  const slice::MaterialMapper mapper(palette, model.properties);
+  const Layout layout = make_layout(model, palette);
+  const std::string model_sha = opt.model_file.empty() ? std::string() : sha256_file(opt.model_file);
+  prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
+  openvdb::initialize();
+
+  const int N = plan.supersample;
+  const int nx = plan.count[0], ny = plan.count[1], nz = plan.count[2];
+  const int ny_pad = (ny + leaf_dim - 1) / leaf_dim * leaf_dim;
+  const double vx = plan.voxel_mm;
+
+  // The fine grid: its voxel centres are the sub-samples. Rows padded to whole leaves in y, so
+  // every task's rows start on a block of the sampler (LayerSampler::block_rows).
+  slice::VoxelGrid fine;
+  fine.origin = plan.origin;
+  fine.pitch = {vx / N, vx / N, vx / N};
+  fine.count = {nx * N, ny_pad * N, nz * N};
+  const slice::LayerSampler sampler(model, fine);
+  const int nyf = fine.count[1];
+
+  // Tasks: 8 layers (one leaf) in z by `band` rows (whole leaves) in y, every column.
+  const std::int64_t n3 = static_cast<std::int64_t>(N) * N * N;
+  const std::int64_t per_leaf_row = static_cast<std::int64_t>(leaf_dim) * leaf_dim * nx;  // voxels of 8 x 8 rows
+  const std::int64_t leaves_y =
+      std::max<std::int64_t>(1, std::min(task_voxels / per_leaf_row, task_samples / (per_leaf_row * n3)));
+  const int band = static_cast<int>(std::min<std::int64_t>(leaves_y * leaf_dim, ny_pad));
+  const int bands = (ny + band - 1) / band;
+  const int slab0 = opt.layer_range ? (*opt.layer_range)[0] / leaf_dim : 0;
+  const int slab1 = opt.layer_range ? ((*opt.layer_range)[1] + leaf_dim - 1) / leaf_dim : (nz + leaf_dim - 1) / leaf_dim;
+  const int tasks = bands * (slab1 - slab0);
+  const int P = layout.nprops, M = layout.nmat;
+  const int channels = P + M;
+  const float inv_n3 = 1.0f / static_cast<float>(n3);
+
+  tbb::enumerable_thread_specific<Scratch> scratch;
+
+  auto run_task = [&](int t) {
+    TaskOut out;
+    out.index = t;
+    out.material_sum.assign(static_cast<std::size_t>(M), 0.0);
+    const int k0 = (slab0 + t / bands) * leaf_dim, k1 = std::min(k0 + leaf_dim, nz);
+    const int j0 = (t % bands) * band, j1 = std::min(j0 + band, ny);
+    const int nk = k1 - k0, nj = j1 - j0;
+    Scratch& s = scratch.local();
+    const std::size_t voxels = static_cast<std::size_t>(nk) * static_cast<std::size_t>(nj) * static_cast<std::size_t>(nx);
+    s.count.assign(voxels, 0);
+    s.sums.assign(voxels * static_cast<std::size_t>(channels), 0.0);
+    s.fractions.resize(static_cast<std::size_t>(M));
+    // Fine rows of grid rows [j0 N, j1 N) are image rows [nyf - j1 N, nyf - j0 N) (grid.hpp).
+    // The last band samples up to the padded row count, so its first row stays block-aligned;
+    // the padding rows lie outside the model's box (void) and are skipped.
+    const int j1_pad = std::min(j0 + band, ny_pad);
+    const int r_begin = nyf - j1_pad * N, r_end = nyf - j0 * N;
+    for (int kf = k0 * N; kf < k1 * N; ++kf) {
+      const std::size_t kk = static_cast<std::size_t>(kf / N - k0);
+      for (int r0 = r_begin; r0 < r_end; r0 += sample_rows) {
+        const int rows = std::min(sample_rows, r_end - r0);
+        sampler.sample(kf, r0, rows, s.band);
+        out.failures += s.band.failures;
+        for (int r = 0; r < rows; ++r) {
+          const int jf = nyf - 1 - (r0 + r);
+          if (jf / N >= j1) continue;
+          const std::size_t jj = static_cast<std::size_t>(jf / N - j0);
+          const std::size_t row = (kk * static_cast<std::size_t>(nj) + jj) * static_cast<std::size_t>(nx);
+          for (int i_f = 0; i_f < nx * N; ++i_f) {
+            if (s.band.cell_at(r, i_f) < 0) continue;
+            const std::size_t v = row + static_cast<std::size_t>(i_f / N);
+            ++s.count[v];
+            const float* p = s.band.props_at(r, i_f);
+            double* acc = s.sums.data() + v * static_cast<std::size_t>(channels);
+            for (int h = 0; h < P; ++h) acc[h] += p[h];
+            mapper.fractions(p, s.fractions.data());
+            for (int m = 0; m < M; ++m) acc[P + m] += s.fractions[static_cast<std::size_t>(m)];
+          }
+        }
+      }
+    }
+    out.samples = static_cast<std::int64_t>(voxels) * n3;
+
+    // Leaves, one 8^3 block at a time, every grid with the same active voxels.
+    out.density = std::make_shared<openvdb::FloatTree>(0.0f);
+    out.color = std::make_shared<openvdb::Vec3STree>(openvdb::Vec3s(0.0f));
+    for (int m = 0; m < M; ++m) out.materials.push_back(std::make_shared<openvdb::FloatTree>(0.0f));
+    for (std::size_t e = 0; e < layout.extra_props.size(); ++e) out.extras.push_back(std::make_shared<openvdb::FloatTree>(0.0f));
+    std::vector<FloatLeaf*> mat_leaves(static_cast<std::size_t>(M)), extra_leaves(layout.extra_props.size());
+    std::vector<float> mean(static_cast<std::size_t>(channels));
+    for (int bj = j0; bj < j1; bj += leaf_dim)
+      for (int bi = 0; bi < nx; bi += leaf_dim) {
+        const int ei = std::min(bi + leaf_dim, nx), ej = std::min(bj + leaf_dim, j1);
+        bool any = false;
+        for (int k = 0; k < nk && !any; ++k)
+          for (int j = bj; j < ej && !any; ++j)
+            for (int i = bi; i < ei; ++i)
+              if (s.count[(static_cast<std::size_t>(k) * nj + static_cast<std::size_t>(j - j0)) * nx + static_cast<std::size_t>(i)] > 0) {
+                any = true;
+                break;
+              }
+        if (!any) continue;
+        const openvdb::Coord origin(bi, bj, k0);
+        auto* dl = new FloatLeaf(origin, 0.0f, false);
+        auto* cl = new Vec3Leaf(origin, openvdb::Vec3s(0.0f), false);
+        for (auto& l : mat_leaves) l = new FloatLeaf(origin, 0.0f, false);
+        for (auto& l : extra_leaves) l = new FloatLeaf(origin, 0.0f, false);
+        for (int k = 0; k < nk; ++k)
+          for (int j = bj; j < ej; ++j)
+            for (int i = bi; i < ei; ++i) {
+              const std::size_t v = (static_cast<std::size_t>(k) * nj + static_cast<std::size_t>(j - j0)) * nx + static_cast<std::size_t>(i);
+              const std::int32_t c = s.count[v];
+              if (c == 0) continue;
+              const double* acc = s.sums.data() + v * static_cast<std::size_t>(channels);
+              for (int h = 0; h < channels; ++h) mean[static_cast<std::size_t>(h)] = static_cast<float>(acc[h] / c);
+              const float density = static_cast<float>(c) * inv_n3;
+              const openvdb::Index off = FloatLeaf::coordToOffset(openvdb::Coord(i, j, k0 + k));
+              dl->setValueOn(off, density);
+              ++out.active;
+              if (c < n3) ++out.fractional;
+              out.density_sum += density;
+              openvdb::Vec3s rgb(0.0f);
+              if (layout.rgb) {
+                for (int q = 0; q < 3; ++q)
+                  rgb[q] = std::clamp(mean[static_cast<std::size_t>(layout.rgb_props[static_cast<std::size_t>(q)])], 0.0f, 1.0f);
+              } else {
+                for (int m = 0; m < M; ++m)
+                  for (int q = 0; q < 3; ++q)
+                    rgb[q] += mean[static_cast<std::size_t>(P + m)] * layout.material_rgb[static_cast<std::size_t>(m)][static_cast<std::size_t>(q)];
+                for (int q = 0; q < 3; ++q) rgb[q] = std::clamp(rgb[q], 0.0f, 1.0f);
+              }
+              cl->setValueOn(off, rgb);
+              for (int m = 0; m < M; ++m) {
+                const float f = mean[static_cast<std::size_t>(P + m)];
+                mat_leaves[static_cast<std::size_t>(m)]->setValueOn(off, f);
+                out.material_sum[static_cast<std::size_t>(m)] += static_cast<double>(f) * density;
+              }
+              for (std::size_t e = 0; e < extra_leaves.size(); ++e)
+                extra_leaves[e]->setValueOn(off, mean[static_cast<std::size_t>(layout.extra_props[e])]);
+            }
+        out.density->addLeaf(dl);
+        out.color->addLeaf(cl);
+        for (int m = 0; m < M; ++m) out.materials[static_cast<std::size_t>(m)]->addLeaf(mat_leaves[static_cast<std::size_t>(m)]);
+        for (std::size_t e = 0; e < extra_leaves.size(); ++e) out.extras[e]->addLeaf(extra_leaves[e]);
+      }
+    return out;
+  };
+
+  // The grids, filled by merging the tasks' trees in task order.
+  auto density = openvdb::FloatGrid::create(0.0f);
+  auto color = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  std::vector<openvdb::FloatGrid::Ptr> materials, extras;
+  for (int m = 0; m < M; ++m) materials.push_back(openvdb::FloatGrid::create(0.0f));
+  for (std::size_t e = 0; e < layout.extra_props.size(); ++e) extras.push_back(openvdb::FloatGrid::create(0.0f));
+
+  VdbJobSummary sum;
+  sum.plan = plan;
+  sum.material_volume_mm3.assign(static_cast<std::size_t>(M), 0.0);
+  double density_sum = 0.0;
+  int done = 0, next = 0;
+  const int tokens = static_cast<int>(tbb::this_task_arena::max_concurrency()) + 1;
+  tbb::parallel_pipeline(
+      static_cast<std::size_t>(tokens),
+      tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
+                                  [&](tbb::flow_control& fc) {
+                                    if (next >= tasks) {
+                                      fc.stop();
+                                      return 0;
+                                    }
+                                    return next++;
+                                  }) &
+          tbb::make_filter<int, std::shared_ptr<TaskOut>>(
+              tbb::filter_mode::parallel, [&](int t) { return std::make_shared<TaskOut>(run_task(t)); }) &
+          tbb::make_filter<std::shared_ptr<TaskOut>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<TaskOut> o) {
+            density->tree().merge(*o->density);
+            color->tree().merge(*o->color);
+            for (int m = 0; m < M; ++m) materials[static_cast<std::size_t>(m)]->tree().merge(*o->materials[static_cast<std::size_t>(m)]);
+            for (std::size_t e = 0; e < extras.size(); ++e) extras[e]->tree().merge(*o->extras[e]);
+            sum.active_voxels += o->active;
+            sum.fractional_voxels += o->fractional;
+            sum.inversion_failures += o->failures;
+            sum.samples += o->samples;
+            density_sum += o->density_sum;
+            for (int m = 0; m < M; ++m) sum.material_volume_mm3[static_cast<std::size_t>(m)] += o->material_sum[static_cast<std::size_t>(m)];
+            ++done;
+            if (progress)
+              progress(done, tasks, sum.samples,
+                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+          }));
+
+  const double voxel_volume = vx * vx * vx;
+  sum.volume_mm3 = density_sum * voxel_volume;
+  for (double& v : sum.material_volume_mm3) v *= voxel_volume;
+
+  // Transform: index (i, j, k) at world origin + (ijk + 1/2) voxel.
+  auto xform = openvdb::math::Transform::createLinearTransform(vx);
+  xform->postTranslate(openvdb::Vec3d(plan.origin[0] + vx / 2, plan.origin[1] + vx / 2, plan.origin[2] + vx / 2));
+
+  openvdb::MetaMap meta;
+  meta.insertMeta("units", openvdb::StringMetadata("mm"));
+  meta.insertMeta("generator", openvdb::StringMetadata(std::string("trivox ") + trivox::version));
+  meta.insertMeta("source", openvdb::StringMetadata(opt.model_file.filename().string()));
+  meta.insertMeta("source_sha256", openvdb::StringMetadata(model_sha));
+  meta.insertMeta("voxel_size", openvdb::DoubleMetadata(vx));
+  meta.insertMeta("supersample", openvdb::Int32Metadata(N));
+  meta.insertMeta("palette", openvdb::StringMetadata(palette.name));
+  meta.insertMeta("palette_sha256", openvdb::StringMetadata(sha256_hex(slice::palette_json(palette))));
+  meta.insertMeta("colour_source", openvdb::StringMetadata(layout.rgb ? "r,g,b" : "palette"));
+
+  openvdb::GridCPtrVec grids;
+  auto finish = [&](openvdb::GridBase::Ptr g, const std::string& name) {
+    g->setName(name);
+    g->setTransform(xform->copy());
+    for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it) g->insertMeta(it->first, *it->second);
+    grids.push_back(g);
+    sum.grids.push_back(name);
+  };
+  density->setGridClass(openvdb::GRID_FOG_VOLUME);
+  finish(density, "density");
+  color->setVectorType(openvdb::VEC_INVARIANT);
+  auto cd = color->deepCopy();
+  finish(color, "color");
+  finish(cd, "Cd");
+  for (int m = 0; m < M; ++m) {
+    const auto& mat = palette.materials[static_cast<std::size_t>(m)];
+    auto& g = materials[static_cast<std::size_t>(m)];
+    g->insertMeta("material", openvdb::StringMetadata(mat.name));
+    g->insertMeta("rgba", openvdb::StringMetadata(std::to_string(mat.rgba[0]) + " " + std::to_string(mat.rgba[1]) + " " +
+                                                  std::to_string(mat.rgba[2]) + " " + std::to_string(mat.rgba[3])));
+    finish(g, "material." + mat.name);
+  }
+  for (std::size_t e = 0; e < extras.size(); ++e) {
+    extras[e]->insertMeta("property", openvdb::StringMetadata(model.properties[static_cast<std::size_t>(layout.extra_props[e])]));
+    finish(extras[e], layout.extra_names[e]);
+  }
+
+  const auto [bytes, digest] = write_vdb_file(plan.file, grids, meta);
+
+  sum.file = plan.file;
+  sum.materials.reserve(static_cast<std::size_t>(M));
+  for (const auto& m : palette.materials) sum.materials.push_back(m.name);
+  sum.colour_source = layout.rgb ? "r,g,b" : "palette";
+  sum.palette = palette.name;
+  sum.sha256 = digest;
+  sum.bytes = bytes;
+  sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return sum;
+}
+
+void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
+  if (parts.empty()) throw Error(out.string() + ": no VDB parts to merge; expected at least one");
+  openvdb::initialize();
+  openvdb::GridPtrVec merged;
+  openvdb::MetaMap meta;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    openvdb::GridPtrVecPtr grids;
+    openvdb::MetaMap::Ptr file_meta;
+    try {
+      std::ifstream in(parts[p], std::ios::binary);
+      if (!in) throw Error(parts[p].string() + ": cannot open: " + reason(errno) + "; expected a shard's VDB part");
+      openvdb::io::Stream stream(in);
+      grids = stream.getGrids();
+      file_meta = stream.getMetadata();
+    } catch (const openvdb::Exception& e) {
+      throw Error(parts[p].string() + ": cannot read it as a VDB file (" + e.what() + "); expected a shard's VDB part");
+    }
+    if (p == 0) {
+      // OpenVDB hands the grids back sorted by name; the file order (density first) is that of
+      // their descriptors, each starting with the name and the type, length-prefixed.
+      const std::string bytes = read_file(parts[p]);
+      auto position = [&](const openvdb::GridBase::Ptr& g) {
+        auto field = [](const std::string& t) {
+          const auto n = static_cast<std::uint32_t>(t.size());
+          std::string f(4, '\0');
+          for (int b = 0; b < 4; ++b) f[static_cast<std::size_t>(b)] = static_cast<char>((n >> (8 * b)) & 0xff);
+          return f + t;
+        };
+        const auto at = bytes.find(field(g->getName()) + field(g->type()));
+        if (at == std::string::npos)
+          throw Error(parts[p].string() + ": grid " + g->getName() + " not found in the file; expected an OpenVDB 10 file");
+        return at;
+      };
+      merged = *grids;
+      std::vector<std::pair<std::size_t, openvdb::GridBase::Ptr>> order;
+      for (auto& g : merged) order.emplace_back(position(g), g);
+      std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (std::size_t g = 0; g < order.size(); ++g) merged[g] = order[g].second;
+      meta = *file_meta;
+      continue;
+    }
+    // The other parts' grids, matched to the first's by name.
+    std::map<std::string, openvdb::GridBase::Ptr> by_name;
+    for (auto& g : *grids) by_name[g->getName()] = g;
+    openvdb::GridPtrVec ordered;
+    for (auto& g : merged) {
+      const auto it = by_name.find(g->getName());
+      if (it == by_name.end())
+        throw Error(parts[p].string() + ": no grid " + g->getName() + "; expected the grids of " + parts[0].string());
+      ordered.push_back(it->second);
+    }
+    *grids = ordered;
+    if (grids->size() != merged.size())
+      throw Error(parts[p].string() + ": " + std::to_string(grids->size()) + " grids; expected " +
+                  std::to_string(merged.size()) + " like " + parts[0].string());
+    for (std::size_t g = 0; g < grids->size(); ++g) {
+      auto& into = merged[g];
+      auto& from = (*grids)[g];
+      if (from->getName() != into->getName() || from->type() != into->type() ||
+          from->transform() != into->transform())
+        throw Error(parts[p].string() + ": grid " + std::to_string(g) + " (" + from->getName() + ", " + from->type() +
+                    ") differs from " + parts[0].string() + " (" + into->getName() + ", " + into->type() +
+                    "); expected parts of one job");
+      // The parts hold disjoint whole leaves (shards are whole 8-layer blocks): merging moves
+      // them, as the job itself merges its tasks' trees.
+      if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(into)) {
+        f->tree().merge(openvdb::gridPtrCast<openvdb::FloatGrid>(from)->tree());
+      } else if (auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(into)) {
+        v->tree().merge(openvdb::gridPtrCast<openvdb::Vec3SGrid>(from)->tree());
+      } else {
+        throw Error(parts[p].string() + ": grid " + from->getName() + " of type " + from->type() +
+                    "; expected the float and vec3s grids trivox writes");
+      }
+    }
+  }
+  // OpenVDB adds statistics (file_bbox_*, file_voxel_count, ...) to grids it writes and reads
+  // them back as metadata: drop them so they are computed afresh for the merged grids.
+  openvdb::GridCPtrVec out_grids;
+  for (auto& g : merged) {
+    for (const char* stat : {"file_bbox_min", "file_bbox_max", "file_mem_bytes", "file_voxel_count", "file_compression",
+                             "file_delayed_load"})
+      g->removeMeta(stat);
+    out_grids.push_back(g);
+  }
+  write_vdb_file(out, out_grids, meta);
+}
+
+}  // namespace trivox::io

@@ -1,0 +1,185 @@
+// The job manifest (io/manifest.hpp): shards' layer ranges, scheduler environments, the JSON
+// round trip and its refusals.
+#include <catch2/catch.hpp>
+
+#include <map>
+#include <string>
+
+#include "trivox/error.hpp"
+#include "trivox/io/manifest.hpp"
+
+using namespace trivox;
+using namespace trivox::io;
+
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    CHECK(e.kind() == ErrorKind::bad_input);
+    return e.what();
+  }
+  FAIL("no error");
+  return {};
+}
+
+Manifest sample() {
+  Manifest m;
+  m.trivox = "0.1.0";
+  m.model_file = "models/twisted_column.json";
+  m.model_sha256 = std::string(64, 'a');
+  m.options = {{"png.dpi", "600,300"}, {"png.layer_mm", "0.027"}, {"vdb.voxel_mm", "auto"}};
+  m.grid = {10, 20, 30};
+  m.dpi_x = 600;
+  m.dpi_y = 300;
+  m.layer_mm = 0.027;
+  m.materials = {"VeroCyan-V", "VeroBlack"};
+  m.colours = {{0, 137, 166, 255}, {26, 26, 29, 255}};
+  m.shard = {1, 3};
+  m.layer_range = m.shard.range(30);
+  for (int k = m.layer_range[0]; k < m.layer_range[1]; k += 2)
+    m.layers.push_back({k, "slice_" + std::to_string(k) + ".png", std::string(64, 'b'), {k, 2 * k}, k % 3});
+  m.files = {{"vdb", "col.shard-1-of-3.vdb", std::string(64, 'c')}};
+  return m;
+}
+
+// A fake environment for shard_from_environment.
+std::map<std::string, std::string> env;
+const char* fake_getenv(const char* name) {
+  const auto it = env.find(name);
+  return it == env.end() ? nullptr : it->second.c_str();
+}
+
+}  // namespace
+
+TEST_CASE("shards cover every layer once, in contiguous ranges of whole 8-layer blocks", "[manifest]") {
+  for (int nz = 0; nz <= 100; ++nz)
+    for (int n = 1; n <= 12; ++n) {
+      int expect = 0, smallest = 1 << 30, largest = 0;
+      for (int k = 0; k < n; ++k) {
+        const auto r = Shard{k, n}.range(nz);
+        REQUIRE(r[0] == expect);  // contiguous, in order, from 0
+        REQUIRE(r[1] >= r[0]);
+        CHECK((r[0] % 8 == 0 || r[0] == nz));  // starts on a leaf boundary
+        const int blocks = (r[1] - r[0] + 7) / 8;
+        smallest = std::min(smallest, blocks);
+        largest = std::max(largest, blocks);
+        expect = r[1];
+      }
+      REQUIRE(expect == nz);                // the last one ends at the top
+      CHECK(largest - smallest <= 1);       // as even as whole blocks allow
+    }
+  CHECK(Shard{0, 1}.range(17) == std::array<int, 2>{0, 17});
+}
+
+TEST_CASE("shard names and --shard K/N", "[manifest]") {
+  CHECK(Shard{0, 1}.manifest_name() == "manifest.json");
+  CHECK(Shard{2, 3}.manifest_name() == "manifest.shard-2-of-3.json");
+  CHECK(Shard{0, 4}.part_name("teapot.vdb") == "teapot.shard-0-of-4.vdb");
+  CHECK(Shard{0, 1}.part_name("teapot.vdb") == "teapot.vdb");
+  CHECK(parse_shard("0/3") == Shard{0, 3});
+  CHECK(parse_shard("2/3") == Shard{2, 3});
+  for (const char* bad : {"3/3", "1", "-1/3", "1/0", "a/3", "1/3/4", "", "1/", "/3", "1/1000000", " 1/3"})
+    CHECK_THAT(error_of([&] { parse_shard(bad); }), Catch::Contains("expected K/N with 0 <= K < N"));
+}
+
+TEST_CASE("the shard from a scheduler's environment; explicit values checked", "[manifest]") {
+  env.clear();
+  CHECK(!shard_from_environment(std::nullopt, fake_getenv));
+  CHECK(!shard_from_environment(4, fake_getenv));
+
+  // Slurm: an array 5-7 is task ids 5, 6, 7 with count 3.
+  env = {{"SLURM_ARRAY_TASK_ID", "6"}, {"SLURM_ARRAY_TASK_MIN", "5"}, {"SLURM_ARRAY_TASK_COUNT", "3"}};
+  CHECK(shard_from_environment(std::nullopt, fake_getenv) == Shard{1, 3});
+  env = {{"SLURM_ARRAY_TASK_ID", "2"}, {"SLURM_ARRAY_TASK_COUNT", "4"}};
+  CHECK(shard_from_environment(std::nullopt, fake_getenv) == Shard{2, 4});
+  env = {{"SLURM_ARRAY_TASK_ID", "9"}, {"SLURM_ARRAY_TASK_MIN", "5"}, {"SLURM_ARRAY_TASK_COUNT", "3"}};
+  CHECK_THAT(error_of([] { shard_from_environment(std::nullopt, fake_getenv); }), Catch::Contains("expected 0 to 2"));
+  env = {{"SLURM_ARRAY_TASK_ID", "1"}};
+  CHECK_THAT(error_of([] { shard_from_environment(std::nullopt, fake_getenv); }),
+             Catch::Contains("SLURM_ARRAY_TASK_COUNT is not"));
+  env = {{"SLURM_ARRAY_TASK_ID", "x"}, {"SLURM_ARRAY_TASK_COUNT", "3"}};
+  CHECK_THAT(error_of([] { shard_from_environment(std::nullopt, fake_getenv); }),
+             Catch::Contains("SLURM_ARRAY_TASK_ID=\"x\": expected an integer"));
+
+  // Kubernetes Indexed Job: the index from the environment, the count from --shard-count.
+  env = {{"JOB_COMPLETION_INDEX", "3"}};
+  CHECK(shard_from_environment(5, fake_getenv) == Shard{3, 5});
+  CHECK_THAT(error_of([] { shard_from_environment(std::nullopt, fake_getenv); }), Catch::Contains("--shard-count N"));
+  CHECK_THAT(error_of([] { shard_from_environment(3, fake_getenv); }), Catch::Contains("expected 0 to 2"));
+  CHECK_THAT(error_of([] { shard_from_environment(0, fake_getenv); }), Catch::Contains("--shard-count 0"));
+  env.clear();
+}
+
+TEST_CASE("a manifest survives its JSON round trip exactly", "[manifest]") {
+  const Manifest m = sample();
+  const std::string text = manifest_json(m);
+  const Manifest back = parse_manifest(text, "m.json");
+  CHECK(back.trivox == m.trivox);
+  CHECK(back.model_file == m.model_file);
+  CHECK(back.model_sha256 == m.model_sha256);
+  CHECK(back.options == m.options);
+  CHECK(back.grid == m.grid);
+  CHECK(back.dpi_x == m.dpi_x);
+  CHECK(back.dpi_y == m.dpi_y);
+  CHECK(back.layer_mm == m.layer_mm);
+  CHECK(back.materials == m.materials);
+  CHECK(back.colours == m.colours);
+  CHECK(back.shard == m.shard);
+  CHECK(back.layer_range == m.layer_range);
+  CHECK(back.layers == m.layers);
+  CHECK(back.files == m.files);
+  CHECK(back.complete == m.complete);
+  CHECK(manifest_json(back) == text);
+  CHECK(back.same_job(m));
+  REQUIRE(back.layer(m.layers[1].index));
+  CHECK(*back.layer(m.layers[1].index) == m.layers[1]);
+  CHECK(!back.layer(m.layers[0].index + 1));  // odd offsets were never listed
+}
+
+TEST_CASE("same_job compares everything that changes the outputs, and says what differs", "[manifest]") {
+  const Manifest m = sample();
+  Manifest o = m;
+  o.layers.clear();  // progress is not identity
+  o.complete = true;
+  CHECK(m.same_job(o));
+  o = m;
+  o.model_sha256 = std::string(64, 'd');
+  CHECK_THAT(m.difference(o), Catch::Contains("model's SHA-256"));
+  o = m;
+  o.options["png.dpi"] = "600,600";
+  CHECK_THAT(m.difference(o), Catch::Contains("option png.dpi was 600,600, now 600,300"));
+  o = m;
+  o.options.erase("vdb.voxel_mm");
+  CHECK_THAT(m.difference(o), Catch::Contains("vdb.voxel_mm"));
+  o = m;
+  o.trivox = "0.0.9";
+  CHECK_THAT(m.difference(o), Catch::Contains("trivox 0.0.9"));
+  o = m;
+  o.colours[0][0] = 1;
+  CHECK_THAT(m.difference(o), Catch::Contains("materials differ"));
+}
+
+TEST_CASE("malformed manifests are refused with the place and what was expected", "[manifest]") {
+  const std::string good = manifest_json(sample());
+  auto edit = [&](const std::string& from, const std::string& to) {
+    std::string t = good;
+    const auto at = t.find(from);
+    REQUIRE(at != std::string::npos);
+    t.replace(at, from.size(), to);
+    return error_of([&] { parse_manifest(t, "m.json"); });
+  };
+  CHECK_THAT(error_of([] { parse_manifest("{", "m.json"); }), Catch::Contains("m.json: line 1, column 2: malformed JSON"));
+  CHECK_THAT(error_of([] { parse_manifest("[]", "m.json"); }), Catch::Contains("m.json: top level: found an array"));
+  CHECK_THAT(edit("\"trivox_manifest\": 1", "\"trivox_manifest\": 2"), Catch::Contains("/trivox_manifest"));
+  CHECK_THAT(edit("\"sha256\": \"aaaa", "\"sha256\": \"Aaaa"), Catch::Contains("/model/sha256: found the string"));
+  CHECK_THAT(edit("\"index\": 1,\n    \"count\": 3", "\"index\": 3,\n    \"count\": 3"), Catch::Contains("/shard/index"));
+  CHECK_THAT(edit("\"complete\": false", "\"complete\": 0"), Catch::Contains("/complete: found the number 0; expected true or false"));
+  // Shard 1 of 3 of 30 layers: [8, 16), listing layers 8, 10, 12 and 14.
+  CHECK_THAT(edit("\"file\": \"slice_8.png\"", "\"file\": \"../x.png\""), Catch::Contains("/layers/0/file"));
+  CHECK_THAT(edit("\"index\": 10", "\"index\": 8"), Catch::Contains("/layers/1/index"));  // not ascending
+  CHECK_THAT(edit("\"index\": 8", "\"index\": 7"), Catch::Contains("/layers/0/index"));   // outside the range
+  CHECK_THAT(edit("\"layer_range\": [\n    8,", "\"layer_range\": [\n    -1,"), Catch::Contains("/layer_range/0"));
+  CHECK_THAT(edit("\"voxels\": [\n        8,", "\"voxels\": [\n"), Catch::Contains("/layers/0/voxels: found an array of 1"));
+}
