@@ -15,6 +15,7 @@
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_job.hpp"
 #include "trivox/io/vdb_job.hpp"
+#include "trivox/version.hpp"
 
 namespace trivox::cli {
 
@@ -177,9 +178,6 @@ void add_slice(CLI::App& app, Common& common) {
     else if (sub->count("--shard-count"))
       throw Error("--shard-count " + std::to_string(opt->shard_count) +
                   ": without JOB_COMPLETION_INDEX in the environment; expected a Kubernetes Indexed Job, or --shard K/N");
-    if (!want_png && (shard.count > 1 || opt->resume))
-      throw Error(std::string(shard.count > 1 ? "--shard" : "--resume") +
-                  ": works on jobs with the PNG stack, whose manifest lists the layers; expected --png with --vdb");
     const auto model = io::load_model(opt->model);
     io::VdbJobOptions vj;
     std::optional<io::VdbPlan> plan;
@@ -202,11 +200,59 @@ void add_slice(CLI::App& app, Common& common) {
     if (opt->threads > 0)
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     static_cast<std::size_t>(opt->threads));
+    // The manifest's identity of the job (manifest.hpp): the model's bytes and the VDB's options.
+    std::map<std::string, std::string> vdb_options{{"vdb", want_vdb ? "yes" : "no"}};
+    if (plan) {
+      vdb_options["vdb.voxel_mm"] = canonical(plan->voxel_mm);
+      vdb_options["vdb.supersample"] = std::to_string(plan->supersample);
+    }
+    const std::string model_sha = io::sha256_file(opt->model);
+    // A resumed job keeps its VDB when the manifest lists it and it verifies.
+    auto verified_vdb = [&]() -> std::optional<io::ManifestFile> {
+      if (want_vdb && opt->resume)
+        if (const auto m = io::read_manifest(opt->out, shard.manifest_name()))
+          for (const auto& f : m->files)
+            if (f.role == "vdb" && f.file == plan->file.filename().string() &&
+                std::filesystem::is_regular_file(plan->file) && io::sha256_file(plan->file) == f.sha256)
+              return f;
+      return std::nullopt;
+    };
     if (!want_png) {
-      const auto v = io::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
-      if (common.json) return print_json({{"model", opt->model}, {"output", opt->out}, {"vdb", vdb_json(v)}});
+      // A volume-only job: its manifest lists the VDB (a shard's: its part of whole leaves).
+      io::Manifest id;
+      id.trivox = version;
+      id.model_file = opt->model;
+      id.model_sha256 = model_sha;
+      id.options = vdb_options;
+      id.options["png"] = "no";
+      id.options["vdb.palette"] =
+          opt->palette.empty() ? std::string("(built in)") : io::sha256_file(opt->palette);
+      id.grid = plan->count;
+      id.shard = shard;
+      id.layer_range = shard.range(plan->count[2]);
+      const auto previous = io::prepare_job_folder(opt->out, id, opt->force, opt->resume);
+      const auto kept = previous ? verified_vdb() : std::nullopt;
+      std::optional<io::VdbJobSummary> v;
+      if (!kept) {
+        io::write_file_atomically(std::filesystem::path(opt->out) / shard.manifest_name(), io::manifest_json(id));
+        vj.require_empty_folder = false;  // checked above, with the manifest
+        v = io::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
+      }
+      io::finish_manifest(opt->out, shard, {kept ? *kept : io::ManifestFile{"vdb", v->file.filename().string(), v->sha256}});
+      if (common.json) {
+        nlohmann::ordered_json j = {{"model", opt->model}, {"output", opt->out}};
+        if (v) j["vdb"] = vdb_json(*v);
+        else j["vdb_kept"] = kept->file;
+        j["shard"] = {{"index", shard.index}, {"count", shard.count}};
+        j["manifest"] = (std::filesystem::path(opt->out) / shard.manifest_name()).string();
+        return print_json(j);
+      }
       std::printf("sampled %s -> %s\n", opt->model.c_str(), opt->out.c_str());
-      print_vdb(v);
+      if (v) print_vdb(*v);
+      else std::printf("resumed: %s kept (verified against the manifest)\n", kept->file.c_str());
+      if (shard.count > 1)
+        std::printf("shard %d/%d: VDB layers %d to %d; when every shard is done: trivox merge %s\n", shard.index,
+                    shard.count, id.layer_range[0], id.layer_range[1] - 1, opt->out.c_str());
       return;
     }
     io::SliceJobOptions job;
@@ -227,26 +273,14 @@ void add_slice(CLI::App& app, Common& common) {
     job.dither = opt->dither;
     job.force = opt->force;
     job.zip = opt->zip;
-    // The manifest's identity of the job (manifest.hpp): the model's bytes and the VDB's options.
     job.model_file = opt->model;
-    job.model_sha256 = io::sha256_file(opt->model);
-    job.extra_options["vdb"] = want_vdb ? "yes" : "no";
-    if (plan) {
-      job.extra_options["vdb.voxel_mm"] = canonical(plan->voxel_mm);
-      job.extra_options["vdb.supersample"] = std::to_string(plan->supersample);
-    }
+    job.model_sha256 = model_sha;
+    job.extra_options = vdb_options;
     job.last_output = !want_vdb;  // the VDB follows and completes the manifest
     job.max_voxels = opt->max_voxels;
     job.resume = opt->resume;
     job.shard = shard;
-    // A resumed job keeps its VDB when the manifest lists it and it verifies.
-    std::optional<io::ManifestFile> vdb_done;
-    if (want_vdb && opt->resume)
-      if (const auto m = io::read_manifest(opt->out, shard.manifest_name()))
-        for (const auto& f : m->files)
-          if (f.role == "vdb" && f.file == plan->file.filename().string() && std::filesystem::is_regular_file(plan->file) &&
-              io::sha256_file(plan->file) == f.sha256)
-            vdb_done = f;
+    const std::optional<io::ManifestFile> vdb_done = verified_vdb();
     const auto s = io::run_slice_job(model, job, make_progress(opt->progress));
     std::optional<io::VdbJobSummary> v;
     if (want_vdb && vdb_done) {

@@ -75,6 +75,8 @@ MergeSummary merge_job(const fs::path& dir) {
                 "sliced with --shard K/N or a scheduler's array index");
   const Manifest& job = *first;
   const int n = job.shard.count, nz = job.grid[2];
+  const auto png_option = job.options.find("png");
+  const bool png = png_option == job.options.end() || png_option->second != "no";  // a PNG stack
 
   // Every problem, per shard.
   std::vector<std::string> problems;
@@ -95,8 +97,9 @@ MergeSummary merge_job(const fs::path& dir) {
       } else if (!m.complete) {
         problem = "unfinished: " + std::to_string(m.layers.size()) + " of " + std::to_string(range[1] - range[0]) +
                   " layers";
-      } else if (static_cast<int>(m.layers.size()) != range[1] - range[0]) {
-        problem = "lists " + std::to_string(m.layers.size()) + " layers; expected " + std::to_string(range[1] - range[0]);
+      } else if (static_cast<int>(m.layers.size()) != (png ? range[1] - range[0] : 0)) {
+        problem = "lists " + std::to_string(m.layers.size()) + " layers; expected " +
+                  std::to_string(png ? range[1] - range[0] : 0);
       } else {
         std::vector<char> ok(m.layers.size(), 0);
         tbb::parallel_for(std::size_t{0}, m.layers.size(),
@@ -129,7 +132,7 @@ MergeSummary merge_job(const fs::path& dir) {
   // The merged manifest and stack.
   Manifest merged = job;
   merged.shard = {0, 1};
-  merged.layer_range = {0, nz};
+  merged.layer_range = {0, nz};  // for a volume-only job: the VDB's layers
   merged.layers.clear();
   merged.files.clear();
   MergeSummary sum;
@@ -159,7 +162,7 @@ MergeSummary merge_job(const fs::path& dir) {
     throw Error(dir.string() + ": only " + std::to_string(vdb_parts.size()) + " of " + std::to_string(n) +
                 " shards list a VDB part; expected all or none");
 
-  if (nz > 0 && job.options.count("png.dpi")) {
+  if (png) {
     const StackConfig cfg = stack_config_of(job, sum.material_voxels);
     const std::string config = config_xml(cfg);
     write_file_atomically(dir / "ConfigFile.xml", config);

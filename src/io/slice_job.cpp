@@ -50,51 +50,6 @@ bool is_manifest_name(const std::string& name) {
   return name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json"));
 }
 
-/// The output folder, created if absent. A whole job without --resume wants it new or empty
-/// (or --force); shards share one folder with their siblings; and any manifest in it must be
-/// of the same job (or --force). Returns this job's (part's) manifest when resuming it.
-std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& id, const SliceJobOptions& opt) {
-  std::error_code ec;
-  std::optional<Manifest> own;
-  if (fs::exists(dir, ec)) {
-    if (!fs::is_directory(dir, ec))
-      throw Error(dir.string() + ": exists and is not a folder; expected a new or empty folder for the slices");
-    bool empty = true, same_job_there = false;
-    for (const auto& entry : fs::directory_iterator(dir, ec)) {
-      const std::string name = entry.path().filename().string();
-      if (name.starts_with(".trivox-write-test")) continue;
-      empty = false;
-      if (!is_manifest_name(name)) continue;
-      const auto m = read_manifest(dir, name);
-      if (const std::string why = id.difference(*m); !why.empty()) {
-        if (!opt.force)
-          throw Error(dir.string() + ": holds another job (" + name + ": " + why +
-                      "); expected the same model and options to resume or add shards (or --force to overwrite, or "
-                      "another folder)");
-        continue;
-      }
-      same_job_there = true;
-      if (name == id.shard.manifest_name()) own = *m;
-    }
-    if (!empty && !opt.force && !opt.resume && id.shard.count == 1)
-      throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (" +
-                  (same_job_there ? std::string("--resume to continue the unfinished job there, ") : std::string()) +
-                  "or --force to overwrite)");
-  } else if ((!fs::create_directories(dir, ec) || ec) && !fs::is_directory(dir)) {  // a sibling shard may win
-    throw Error(dir.string() + ": cannot create the folder (" + ec.message() + "); expected a writable location");
-  }
-  // Probe writability now rather than after the first layer (a name of this shard's own).
-  const fs::path probe = dir / (".trivox-write-test" + (id.shard.count > 1 ? "-" + std::to_string(id.shard.index) : std::string()));
-  try {
-    write_file_atomically(probe, "");
-  } catch (const Error& e) {
-    throw Error(dir.string() + ": the folder is not writable; expected a writable folder");
-  }
-  fs::remove(probe, ec);
-  if (!opt.resume) own.reset();
-  return own;
-}
-
 /// Canonical text of a number for the manifest's options (round-trips).
 std::string canonical(double v) {
   char buf[32];
@@ -130,6 +85,48 @@ struct LayerOut {
 };
 
 }  // namespace
+
+std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& id, bool force, bool resume) {
+  std::error_code ec;
+  std::optional<Manifest> own;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec))
+      throw Error(dir.string() + ": exists and is not a folder; expected a new or empty folder for the slices");
+    bool empty = true, same_job_there = false;
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (name.starts_with(".trivox-write-test")) continue;
+      empty = false;
+      if (!is_manifest_name(name)) continue;
+      const auto m = read_manifest(dir, name);
+      if (const std::string why = id.difference(*m); !why.empty()) {
+        if (!force)
+          throw Error(dir.string() + ": holds another job (" + name + ": " + why +
+                      "); expected the same model and options to resume or add shards (or --force to overwrite, or "
+                      "another folder)");
+        continue;
+      }
+      same_job_there = true;
+      if (name == id.shard.manifest_name()) own = *m;
+    }
+    if (!empty && !force && !resume && id.shard.count == 1)
+      throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (" +
+                  (same_job_there ? std::string("--resume to continue (or verify) the job there, ") : std::string()) +
+                  "or --force to overwrite)");
+  } else if ((!fs::create_directories(dir, ec) || ec) && !fs::is_directory(dir)) {  // a sibling shard may win
+    throw Error(dir.string() + ": cannot create the folder (" + ec.message() + "); expected a writable location");
+  }
+  // Probe writability now rather than after the first layer (a name of this shard's own).
+  const fs::path probe = dir / (".trivox-write-test" + (id.shard.count > 1 ? "-" + std::to_string(id.shard.index) : std::string()));
+  try {
+    write_file_atomically(probe, "");
+  } catch (const Error& e) {
+    throw Error(dir.string() + ": the folder is not writable; expected a writable folder");
+  }
+  fs::remove(probe, ec);
+  if (!resume) own.reset();
+  return own;
+}
 
 slice::VoxelGrid slice_grid(const vmodel::VModel& model, const slice::PrintProfile& profile) {
   if (model.cells.empty())
@@ -184,6 +181,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   manifest.model_file = opt.model_file.empty() ? opt.model_name : opt.model_file;
   manifest.model_sha256 = opt.model_sha256;
   manifest.options = opt.extra_options;
+  manifest.options["png"] = "yes";
   manifest.options["png.dpi"] = canonical(opt.profile.dpi_x) + "," + canonical(opt.profile.dpi_y);
   manifest.options["png.layer_mm"] = canonical(opt.profile.layer_mm);
   manifest.options["png.printer"] = opt.profile.name;
@@ -200,7 +198,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
   manifest.shard = opt.shard;
   manifest.layer_range = opt.shard.range(nz);
-  const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt);
+  const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt.force, opt.resume);
   StackConfig cfg = stack_config_of(manifest, {});
 
   std::map<int, ManifestLayer> finished;  // by layer

@@ -128,7 +128,14 @@ cmp "$tmp/vw/whole/manifest.json" "$tmp/vs/whole/manifest.json"
 grep -q '"vdb_kept": "graded_block.vdb"' "$tmp/vr.json"
 expect_fail "png.dither was fs, now none" "$trivox" slice $model -o "$tmp/vw/whole" "${grid[@]}" "${vdb[@]}" --resume --dither none
 expect_fail "vdb.voxel_mm was 0.5, now 1" "$trivox" slice $model -o "$tmp/vw/whole" "${grid[@]}" --png --vdb --vdb-voxel 1 --resume
-expect_fail "expected --png with --vdb" "$trivox" slice $model -o "$tmp/x" --vdb --shard 0/2
+# A volume-only job shards, merges and resumes alike (no layers, no ConfigFile.xml).
+"$trivox" slice $model -o "$tmp/ow/whole" --progress never --vdb --vdb-voxel 0.5 > /dev/null
+for k in 0 1; do "$trivox" slice $model -o "$tmp/os/whole" --progress never --vdb --vdb-voxel 0.5 --shard $k/2 > /dev/null; done
+"$trivox" merge "$tmp/os/whole" > /dev/null
+cmp "$tmp/ow/whole/graded_block.vdb" "$tmp/os/whole/graded_block.vdb"
+cmp "$tmp/ow/whole/manifest.json" "$tmp/os/whole/manifest.json"
+[ ! -e "$tmp/os/whole/ConfigFile.xml" ]
+"$trivox" slice $model -o "$tmp/ow/whole" --progress never --vdb --vdb-voxel 0.5 --resume --json | grep -q '"vdb_kept"'
 
 expect_fail "no shard manifests" "$trivox" merge "$tmp/whole"
 expect_fail "not a folder" "$trivox" merge "$tmp/nowhere"

@@ -86,6 +86,13 @@ using SliceProgress = std::function<void(int layers_done, int layers_total, std:
 /// @throws Error (bad_input) for an empty model or a degenerate box
 slice::VoxelGrid slice_grid(const vmodel::VModel& model, const slice::PrintProfile& profile);
 
+/// The output folder of a job with identity `id` (manifest.hpp), created if absent. A whole job
+/// without `resume` wants it new or empty (or `force`); shards share one folder with their
+/// siblings; any manifest in it must be of the same job (or `force`, which starts over).
+/// @return this job's (shard's) manifest when resuming and there is one
+/// @throws Error (bad_input) naming the folder and the reason
+std::optional<Manifest> prepare_job_folder(const std::filesystem::path& dir, const Manifest& id, bool force, bool resume);
+
 /// Marks the manifest of the job in `dir` (shard `shard`) complete, adding `files` (replacing
 /// entries of the same role): the last step of a job whose outputs were written by several calls.
 /// @throws Error (bad_input) when the manifest is missing or malformed; (failed) when writing fails
