@@ -12,6 +12,7 @@ namespace trivox::cli {
 /// Options common to all subcommands.
 struct Common {
   bool json = false;  ///< print one JSON object on stdout instead of the human summary
+  int exit_code = 0;  ///< what main returns after a successful run (validate: 1 for invalid cells)
 };
 
 /// Each subcommand file defines one of these; main.cpp calls them in order.
@@ -23,6 +24,7 @@ void add_inspect(CLI::App& app, Common& common);
 void add_preview(CLI::App& app, Common& common);
 void add_render(CLI::App& app, Common& common);
 void add_merge(CLI::App& app, Common& common);
+void add_validate(CLI::App& app, Common& common);
 
 /// Parses "a,b,c" into exactly `count` finite numbers.
 /// @param option  the option's name, for the message ("--uvw")

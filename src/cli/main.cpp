@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   trivox::cli::add_preview(app, common);
   trivox::cli::add_render(app, common);
   trivox::cli::add_merge(app, common);
+  trivox::cli::add_validate(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -44,5 +45,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "trivox: error: %s\n", e.what());
     return 1;
   }
-  return 0;
+  return common.exit_code;
 }

@@ -1,0 +1,73 @@
+// `trivox validate MODEL`: Jacobian validity per cell (geom/validity.hpp). Exit 1 when a cell is
+// not valid (invalid or undecided).
+#include <cstdio>
+
+#include "common.hpp"
+#include "trivox/error.hpp"
+#include "trivox/geom/validity.hpp"
+#include "trivox/io/model_file.hpp"
+
+namespace trivox::cli {
+
+namespace {
+struct Options {
+  std::string model;
+};
+}  // namespace
+
+void add_validate(CLI::App& app, Common& common) {
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand(
+      "validate", "Jacobian validity per cell: bounds of the determinant, first invalid location (exit 1 if any is not valid)");
+  sub->add_option("MODEL", opt->model, "Model file (.json, or G+Smo .xml)")->required();
+  sub->add_flag("--json", common.json, "Print one JSON object instead of the summary");
+  sub->callback([opt, &common] {
+    const auto model = io::load_model(opt->model);
+    nlohmann::ordered_json cells = nlohmann::ordered_json::array();
+    bool all_valid = true;
+    if (!common.json)
+      std::printf("%-16s %-10s %-12s %15s %15s\n", "cell", "verdict", "orientation", "min det J", "max det J");
+    for (const auto& c : model.cells) {
+      geom::ValidityReport<3> r;
+      try {
+        r = geom::check_validity(c.volume);
+      } catch (const Error& e) {
+        throw e.within(opt->model + ": cell " + c.name);
+      }
+      const bool valid = r.verdict == geom::Validity::valid;
+      all_valid = all_valid && valid;
+      nlohmann::ordered_json j = {{"name", c.name},
+                                  {"valid", valid},
+                                  {"min_jacobian", r.min_bound},
+                                  {"max_jacobian", r.max_bound},
+                                  {"verdict", geom::validity_name(r.verdict)},
+                                  {"orientation", r.orientation > 0 ? "right-handed" : r.orientation < 0 ? "left-handed" : "singular"},
+                                  {"min_evaluated", r.min_seen},
+                                  {"max_evaluated", r.max_seen},
+                                  {"pieces", r.pieces}};
+      std::string where;
+      if (r.invalid_at) {
+        const auto& t = *r.invalid_at;
+        const auto x = c.volume.eval(t);
+        j["invalid_at"] = {{"uvw", t}, {"xyz", {x[0], x[1], x[2]}}, {"det", r.det_at_invalid}};
+        where = "det J = " + fmt(r.det_at_invalid, 6) + " at (u,v,w) = (" + fmt(t[0], 8) + ", " + fmt(t[1], 8) + ", " +
+                fmt(t[2], 8) + "), xyz (" + fmt(x[0], 8) + ", " + fmt(x[1], 8) + ", " + fmt(x[2], 8) + ")";
+      }
+      cells.push_back(j);
+      if (!common.json) {
+        std::printf("%-16s %-10s %-12s %15s %15s\n", c.name.c_str(), geom::validity_name(r.verdict),
+                    r.orientation > 0 ? "right" : r.orientation < 0 ? "left" : "singular", fmt(r.min_bound, 8).c_str(),
+                    fmt(r.max_bound, 8).c_str());
+        if (!where.empty()) std::printf("  first invalid point: %s\n", where.c_str());
+        if (r.verdict == geom::Validity::undecided)
+          std::printf("  det J comes within [%s, %s] of 0 without being seen to reach it\n", fmt(r.min_bound, 6).c_str(),
+                      fmt(r.max_bound, 6).c_str());
+      }
+    }
+    if (common.json) print_json({{"valid", all_valid}, {"cells", cells}});
+    else std::printf("%s: %s\n", opt->model.c_str(), all_valid ? "every cell is valid" : "NOT every cell is valid");
+    if (!all_valid) common.exit_code = 1;
+  });
+}
+
+}  // namespace trivox::cli

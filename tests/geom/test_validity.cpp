@@ -1,0 +1,144 @@
+// Jacobian validity (geom/validity.hpp). Truths: an affine map's determinant is det A everywhere;
+// the bounds enclose det J computed independently from first partials at random points; a folded
+// cell's reported invalid point has det J <= 0 there (independently evaluated); a collapsed face
+// has det J = 0.
+#include <catch2/catch.hpp>
+
+#include <random>
+
+#include "trivox/error.hpp"
+#include "trivox/geom/validity.hpp"
+
+using namespace trivox;
+using spline::KnotVector;
+using spline::Surface;
+using spline::Trivariate;
+
+namespace {
+
+KnotVector bezier(int order) {
+  std::vector<double> k(static_cast<std::size_t>(order), 0.0);
+  k.resize(static_cast<std::size_t>(2 * order), 1.0);
+  return KnotVector(order, k);
+}
+
+/// A tricubic Bezier cell with control points f(i/3, j/3, k/3) for an xyz map f.
+template <class F>
+Trivariate tricubic(F f) {
+  std::vector<double> pts;
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const auto p = f(i / 3.0, j / 3.0, k / 3.0);
+        pts.insert(pts.end(), p.begin(), p.end());
+      }
+  return Trivariate({bezier(4), bezier(4), bezier(4)}, 3, pts);
+}
+
+/// det[dX/du, dX/dv, dX/dw] from the spline's first partials.
+double det_at(const Trivariate& s, const std::array<double, 3>& t) {
+  const auto v = s.eval_derivatives(t, 1);  // value, d/du, d/dv, d/dw; 3 coordinates each
+  const double* a = v.data() + 3;
+  const double* b = v.data() + 6;
+  const double* c = v.data() + 9;
+  return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+}
+
+void check_bounds_enclose(const Trivariate& s, const geom::ValidityReport<3>& r) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int n = 0; n < 500; ++n) {
+    const double d = det_at(s, {u(rng), u(rng), u(rng)});
+    CHECK(d >= r.min_bound - 1e-9 * std::abs(r.min_bound));
+    CHECK(d <= r.max_bound + 1e-9 * std::abs(r.max_bound));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("an affine cell is valid with det J = det A exactly, oriented by its sign", "[validity]") {
+  // x = 2u + v, y = 3v + w, z = u + 4w: det A = 2*(12 - 0) - 1*(0 - 1) + 0 = 25.
+  const auto s = tricubic([](double u, double v, double w) { return std::array<double, 3>{2 * u + v, 3 * v + w, u + 4 * w}; });
+  const auto r = geom::check_validity(s);
+  CHECK(r.verdict == geom::Validity::valid);
+  CHECK(r.orientation == 1);
+  // The determinant spline comes from product splines, exact to about 1e-9 relative.
+  CHECK(r.min_bound == Approx(25).epsilon(1e-8));
+  CHECK(r.max_bound == Approx(25).epsilon(1e-8));
+  CHECK(r.min_seen == Approx(25).epsilon(1e-8));
+  CHECK(!r.invalid_at);
+  // Mirrored in x: left-handed, still a valid parametrisation.
+  const auto m = tricubic([](double u, double v, double w) { return std::array<double, 3>{-(2 * u + v), 3 * v + w, u + 4 * w}; });
+  const auto rm = geom::check_validity(m);
+  CHECK(rm.verdict == geom::Validity::valid);
+  CHECK(rm.orientation == -1);
+  CHECK(rm.max_bound == Approx(-25).epsilon(1e-8));
+}
+
+TEST_CASE("a curved valid cell: bounds enclose det J everywhere", "[validity]") {
+  // A twisted, tapered column: valid (det J > 0) but far from affine.
+  const auto s = tricubic([](double u, double v, double w) {
+    const double a = 0.6 * w, r = 1.0 + 0.3 * w * w;
+    const double x = r * (u - 0.5), y = r * (v - 0.5);
+    return std::array<double, 3>{std::cos(a) * x - std::sin(a) * y, std::sin(a) * x + std::cos(a) * y, 2 * w + 0.1 * u * v};
+  });
+  const auto r = geom::check_validity(s);
+  CHECK(r.verdict == geom::Validity::valid);
+  CHECK(r.min_bound > 0);
+  CHECK(r.min_bound <= r.min_seen);
+  CHECK(r.max_seen <= r.max_bound);
+  check_bounds_enclose(s, r);
+}
+
+TEST_CASE("a folded cell is invalid, at a point where det J really has the wrong sign", "[validity]") {
+  // x's control polygon along u: 0, 1/3, -1.5, 1 in every row: x' < 0 around u = 1/2 (x'(1/2)
+  // = 3 (1/3 / 4 - 11/6 / 2 + 5/2 / 4) = -5/8), so the map folds over.
+  auto s = tricubic([](double u, double v, double w) { return std::array<double, 3>{u > 0.5 && u < 0.9 ? -1.5 : u, v, w}; });
+  const auto r = geom::check_validity(s);
+  REQUIRE(r.verdict == geom::Validity::invalid);
+  REQUIRE(r.invalid_at);
+  // det J < 0 at the centre (the orientation), > 0 at the corners: invalid where it is >= 0.
+  CHECK(r.orientation == -1);
+  CHECK(det_at(s, *r.invalid_at) * r.orientation <= 1e-12);
+  CHECK(r.det_at_invalid == Approx(det_at(s, *r.invalid_at)).margin(1e-9));
+  CHECK(r.min_bound < 0);
+  CHECK(r.max_bound > 0);
+  check_bounds_enclose(s, r);
+  // Deterministic: the same first invalid point every time.
+  const auto again = geom::check_validity(s);
+  CHECK(*again.invalid_at == *r.invalid_at);
+}
+
+TEST_CASE("a collapsed face makes det J zero there: invalid", "[validity]") {
+  // x = u, y = u v, z = w: the face u = 0 collapses to a segment, det J = u.
+  const auto s = tricubic([](double u, double v, double w) { return std::array<double, 3>{u, u * v, w}; });
+  const auto r = geom::check_validity(s);
+  REQUIRE(r.verdict == geom::Validity::invalid);
+  CHECK((*r.invalid_at)[0] == 0.0);
+  CHECK(r.det_at_invalid == Approx(0).margin(1e-14));
+  CHECK(r.min_bound == Approx(0).margin(1e-12));
+}
+
+TEST_CASE("planar surfaces: a convex quad is valid, a bow tie is not", "[validity]") {
+  const Surface quad({bezier(2), bezier(2)}, 2, {0, 0, 2, 0, 0, 1, 3, 2});
+  const auto r = geom::check_validity(quad);
+  CHECK(r.verdict == geom::Validity::valid);
+  CHECK(r.orientation == 1);
+  // Bilinear: det J = (2 + v) (1 + u) - (u)(...)...: its exact range is enclosed by the bounds.
+  CHECK(r.min_bound > 0);
+  const Surface bowtie({bezier(2), bezier(2)}, 2, {0, 0, 2, 0, 2, 1, 0, 1.2});  // top corners swapped
+  const auto b = geom::check_validity(bowtie);
+  CHECK(b.verdict == geom::Validity::invalid);
+}
+
+TEST_CASE("rational cells are refused with a reason", "[validity]") {
+  std::vector<double> pts, w;
+  for (int i = 0; i < 8; ++i) pts.insert(pts.end(), {double(i & 1), double((i >> 1) & 1), double((i >> 2) & 1)}), w.push_back(1.0 + i);
+  const Trivariate s({bezier(2), bezier(2), bezier(2)}, 3, pts, w);
+  try {
+    geom::check_validity(s);
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK_THAT(e.what(), Catch::Contains("rational"));
+  }
+}
