@@ -7,22 +7,13 @@
 
 #include "trivox/error.hpp"
 #include "trivox/io/manifest.hpp"
+#include "io_test_util.hpp"
 
 using namespace trivox;
 using namespace trivox::io;
+using trivox::io::test::error_of;
 
 namespace {
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    CHECK(e.kind() == ErrorKind::bad_input);
-    return e.what();
-  }
-  FAIL("no error");
-  return {};
-}
 
 Manifest sample() {
   Manifest m;
