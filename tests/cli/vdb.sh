@@ -23,7 +23,16 @@ q="--progress never"
 "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --vdb --vdb-voxel 0.25 --threads 1 $q --json > "$tmp/f1.json"
 "$trivox" slice models/gismo/fichera.xml -o "$tmp/f2" --vdb --vdb-voxel 0.25 --threads 2 $q > "$tmp/f2.txt"
 cmp "$tmp/f1/fichera.vdb" "$tmp/f2/fichera.vdb"       # byte-identical for 1 and 2 threads
-[ "$(ls -A "$tmp/f1")" = "fichera.vdb" ]                # --vdb alone: no PNG stack, no ConfigFile.xml
+# --vdb alone: no PNG stack, no ConfigFile.xml; the manifest lists the VDB with its digest.
+[ "$(ls -A "$tmp/f1" | tr '\n' ' ')" = "fichera.vdb manifest.json " ]
+cmp "$tmp/f1/manifest.json" "$tmp/f2/manifest.json"
+"$py" -c "
+import json, hashlib, sys
+m = json.load(open('$tmp/f1/manifest.json'))
+f = {x['role']: x for x in m['files']}
+assert m['complete'] and m['options']['png'] == 'no' and m['layers'] == [], m
+assert f['vdb']['sha256'] == hashlib.sha256(open('$tmp/f1/fichera.vdb', 'rb').read()).hexdigest()
+"
 grep -q "448 (0 fractional)" "$tmp/f2.txt"
 "$trivox" --version > "$tmp/version"
 
