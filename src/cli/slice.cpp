@@ -66,13 +66,6 @@ io::SliceProgress make_progress(const std::string& mode, const char* unit = "lay
   };
 }
 
-/// The shortest text that reads back to `v` (manifest option values).
-std::string canonical(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
 std::string human_bytes(double b) {
   const char* units[] = {"B", "KB", "MB", "GB", "TB"};
   int u = 0;
@@ -203,7 +196,7 @@ void add_slice(CLI::App& app, Common& common) {
     // The manifest's identity of the job (manifest.hpp): the model's bytes and the VDB's options.
     std::map<std::string, std::string> vdb_options{{"vdb", want_vdb ? "yes" : "no"}};
     if (plan) {
-      vdb_options["vdb.voxel_mm"] = canonical(plan->voxel_mm);
+      vdb_options["vdb.voxel_mm"] = io::option_number(plan->voxel_mm);
       vdb_options["vdb.supersample"] = std::to_string(plan->supersample);
     }
     const std::string model_sha = io::sha256_file(opt->model);

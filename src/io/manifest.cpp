@@ -1,6 +1,7 @@
 #include "trivox/io/manifest.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cerrno>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -167,6 +168,12 @@ std::string Manifest::difference(const Manifest& o) const {
 const ManifestLayer* Manifest::layer(int k) const {
   const auto it = std::lower_bound(layers.begin(), layers.end(), k, [](const ManifestLayer& l, int v) { return l.index < v; });
   return it != layers.end() && it->index == k ? &*it : nullptr;
+}
+
+std::string option_number(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 
 StackConfig stack_config_of(const Manifest& m, const std::vector<std::int64_t>& totals) {

@@ -50,13 +50,6 @@ bool is_manifest_name(const std::string& name) {
   return name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json"));
 }
 
-/// Canonical text of a number for the manifest's options (round-trips).
-std::string canonical(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 /// Per-worker scratch, reused across layers so a job allocates once per thread.
 struct Scratch {
   slice::RowBand band;
@@ -182,8 +175,8 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   manifest.model_sha256 = opt.model_sha256;
   manifest.options = opt.extra_options;
   manifest.options["png"] = "yes";
-  manifest.options["png.dpi"] = canonical(opt.profile.dpi_x) + "," + canonical(opt.profile.dpi_y);
-  manifest.options["png.layer_mm"] = canonical(opt.profile.layer_mm);
+  manifest.options["png.dpi"] = option_number(opt.profile.dpi_x) + "," + option_number(opt.profile.dpi_y);
+  manifest.options["png.layer_mm"] = option_number(opt.profile.layer_mm);
   manifest.options["png.printer"] = opt.profile.name;
   manifest.options["png.palette"] = palette.name + (opt.palette ? " " + sha256_file(*opt.palette) : std::string(" (built in)"));
   manifest.options["png.dither"] = std::string(slice::dither_mode_name(mode));

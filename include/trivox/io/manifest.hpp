@@ -106,6 +106,10 @@ struct Manifest {
   const ManifestLayer* layer(int k) const;
 };
 
+/// A number as an option value: the shortest text that reads back to the same double (0.027,
+/// not 0.027000000000000000).
+std::string option_number(double v);
+
 /// The ConfigFile.xml of the job's PNG stack: resolution, size and palette from the manifest,
 /// with voxel counts `totals` (one per material).
 StackConfig stack_config_of(const Manifest& manifest, const std::vector<std::int64_t>& totals);
