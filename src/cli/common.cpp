@@ -30,7 +30,11 @@ std::vector<double> parse_numbers(const std::string& text, std::size_t count, co
   return out;
 }
 
-void print_json(const nlohmann::ordered_json& value) { std::cout << value.dump(2) << '\n'; }
+// Strings from files (names and metadata of a damaged VDB, say) may hold invalid UTF-8: replaced
+// by U+FFFD rather than refused, so the JSON always prints.
+void print_json(const nlohmann::ordered_json& value) {
+  std::cout << value.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
+}
 
 std::string fmt(double v, int digits) {
   char buf[64];

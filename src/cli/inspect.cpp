@@ -7,6 +7,8 @@
 // corrupt.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 
@@ -123,9 +125,10 @@ nlohmann::ordered_json meta_json(const std::vector<io::VdbMeta>& meta) {
   for (const auto& m : meta) {
     if (m.type == "bool")
       j[m.name] = m.value == "1" || m.value == "true";
-    else if (m.numeric)
-      j[m.name] = m.type == "int32" || m.type == "int64" ? nlohmann::ordered_json(std::stoll(m.value))
-                                                         : nlohmann::ordered_json(std::stod(m.value));
+    else if (m.numeric && m.type != "float" && m.type != "double")
+      j[m.name] = std::stoll(m.value);
+    else if (m.numeric && std::isfinite(std::strtod(m.value.c_str(), nullptr)))  // JSON has no NaN: keep the text
+      j[m.name] = std::strtod(m.value.c_str(), nullptr);
     else
       j[m.name] = m.value;
   }
