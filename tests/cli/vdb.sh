@@ -344,6 +344,11 @@ expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/
 expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --vdb --vdb-voxel 0.25
 expect_fail "no cells" "$trivox" slice models/gismo/teapot.xml -o "$tmp/x2" --vdb
 expect_fail "missing.vdb: no such file" "$trivox" inspect "$tmp/missing.vdb"
+# A damaged name (a byte that is not UTF-8) still reads, and prints as JSON.
+"$py" -c 'import sys; b = open(sys.argv[1], "rb").read(); open(sys.argv[2], "wb").write(b.replace(b"density", b"\xffensity"))' \
+  "$tmp/f1/fichera.vdb" "$tmp/badname.vdb"
+"$trivox" inspect "$tmp/badname.vdb" --json > "$tmp/badname.json"
+"$py" -c 'import json, sys; r = json.load(open(sys.argv[1])); assert any(g["name"] == "\ufffdensity" for g in r["grids"]), r["grids"]' "$tmp/badname.json"
 echo "not a volume" > "$tmp/text.vdb"
 expect_fail "text.vdb: no OpenVDB magic number" "$trivox" inspect "$tmp/text.vdb"
 head -c 600 "$tmp/f1/fichera.vdb" > "$tmp/cut.vdb"
