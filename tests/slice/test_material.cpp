@@ -14,6 +14,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "../io/io_test_util.hpp"  // error_of, check_message: shared with the io tests
 #include "trivox/error.hpp"
 #include "trivox/slice/material.hpp"
 
@@ -22,22 +23,8 @@ namespace {
 using namespace trivox::slice;
 using nlohmann::json;
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const trivox::Error& e) {
-    CHECK(e.kind() == trivox::ErrorKind::bad_input);
-    return e.what();
-  }
-  FAIL("expected a trivox::Error");
-  return {};
-}
-
-void check_message(const std::string& message, std::initializer_list<std::string_view> parts) {
-  INFO("message: " << message);
-  for (std::string_view p : parts) CHECK_THAT(message, Catch::Contains(std::string(p)));
-}
+using trivox::io::test::check_message;
+using trivox::io::test::error_of;
 
 /// The message of parsing `j` (dumped) as the palette file "p.json".
 std::string palette_error(const json& j) {
