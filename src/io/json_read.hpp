@@ -1,0 +1,303 @@
+/// @file src/io/json_read.hpp
+/// @brief Private to io: checked reading of JSON documents, shared by the readers of models,
+/// scenes and constructor inputs. Every value's type and range is checked before it is used, and
+/// every failure is a trivox::Error (bad_input) reading "<file>: <JSON pointer>: <what was
+/// found>; expected <what>" (or "<file>: line L, column C: malformed JSON: ..." for syntax).
+#pragma once
+#include <array>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "../detail/json_text.hpp"
+#include "trivox/error.hpp"
+#include "trivox/spline/tensor_spline.hpp"
+
+namespace trivox::io::json_read {
+
+using nlohmann::json;
+using spline::KnotVector;
+
+// ------------------------------------------------------------------------------------------
+// Message pieces
+
+/// The file being read: every message starts with its name and a JSON pointer.
+struct Source {
+  const std::string& name;
+
+  [[noreturn]] void fail(const std::string& ptr, const std::string& what) const {
+    throw Error(name + ": " + (ptr.empty() ? std::string("top level") : ptr) + ": " + what);
+  }
+  /// For wrapping errors thrown by lower layers (KnotVector, TensorSpline).
+  std::string at(const std::string& ptr) const { return name + ": " + ptr; }
+};
+
+inline std::string child(const std::string& ptr, std::size_t i) { return ptr + "/" + std::to_string(i); }
+inline std::string child(const std::string& ptr, const char* key) { return ptr + "/" + key; }
+
+/// Shortest round-trip text of a double, always with a '.' or exponent so that a reader keeps it
+/// a floating-point number (this is what keeps -0.0 negative through nlohmann's parser).
+inline std::string format_double(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, r.ptr);
+  if (s.find_first_of(".en") == std::string::npos) s += ".0";
+  return s;
+}
+
+inline std::string quote(const std::string& s) { return detail::json_quote(s); }
+
+inline std::string plural(std::int64_t n, const std::string& word) {
+  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
+}
+
+inline std::string describe(const json& j) { return detail::json_describe(j); }
+
+[[noreturn]] inline void fail_type(const Source& src, const std::string& ptr, const json& j,
+                            const std::string& expected) {
+  src.fail(ptr, "found " + describe(j) + "; expected " + expected);
+}
+
+// ------------------------------------------------------------------------------------------
+// Parsing with positions
+
+/// nlohmann's DOM builder, but keeping the byte position of a failure: the library reports a
+/// number overflow (1e999) without one, and the user needs a line to find it.
+class PositionedParser : public nlohmann::detail::json_sax_dom_parser<json> {
+public:
+  explicit PositionedParser(json& root) : json_sax_dom_parser(root, false) {}
+
+  template <class Exception>
+  bool parse_error(std::size_t position, const std::string& token, const Exception& ex) {
+    failed_ = true;
+    message_ = ex.what();
+    // A syntax error is placed at the last character read; an overflowing number at its start.
+    const bool overflow = message_.find("number overflow") != std::string::npos;
+    position_ = overflow && position > token.size() ? position - token.size() + 1 : position;
+    return false;
+  }
+
+  bool failed() const noexcept { return failed_; }
+  std::size_t position() const noexcept { return position_; }
+  const std::string& message() const noexcept { return message_; }
+
+private:
+  bool failed_ = false;
+  std::size_t position_ = 0;
+  std::string message_;
+};
+
+inline json parse(const Source& src, std::string_view text) {
+  json root;
+  PositionedParser parser(root);
+  json::sax_parse(text.begin(), text.end(), &parser, nlohmann::detail::input_format_t::json,
+                  /*strict=*/true, /*ignore_comments=*/false);
+  if (parser.failed())
+    throw Error(src.name + ": " + detail::json_line_column(text, parser.position()) +
+                ": malformed JSON: " + detail::json_parse_message(parser.message()));
+  return root;
+}
+
+// ------------------------------------------------------------------------------------------
+// Typed access: every value's type is checked before it is read
+
+inline const json* find(const json& object, const char* key) {
+  const auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+inline const json& require(const Source& src, const json& object, const std::string& ptr, const char* key,
+                    const std::string& expected) {
+  if (const json* j = find(object, key)) return *j;
+  src.fail(ptr, std::string("missing \"") + key + "\"; expected " + expected);
+}
+
+inline const json& expect_object(const Source& src, const json& j, const std::string& ptr,
+                          const std::string& expected) {
+  if (!j.is_object()) fail_type(src, ptr, j, expected);
+  return j;
+}
+
+inline const json& expect_array(const Source& src, const json& j, const std::string& ptr,
+                         const std::string& expected) {
+  if (!j.is_array()) fail_type(src, ptr, j, expected);
+  return j;
+}
+
+inline double read_number(const Source& src, const json& j, const std::string& ptr) {
+  if (!j.is_number()) fail_type(src, ptr, j, "a number");
+  const double v = j.get<double>();
+  // The parser rejects overflowing literals; this guards models built by other means.
+  if (!std::isfinite(v)) src.fail(ptr, "found " + format_double(v) + "; expected a finite number");
+  return v;
+}
+
+/// read_number of element i of `parent`, building the pointer text only for a message: files
+/// hold millions of numbers.
+inline double read_number_at(const Source& src, const json& j, const std::string& parent, std::size_t i) {
+  if (j.is_number()) {
+    const double v = j.get<double>();
+    if (std::isfinite(v)) return v;
+  }
+  return read_number(src, j, child(parent, i));
+}
+
+/// An integer in [lo, hi]; 2.0 counts as 2, since some writers emit every number as a double.
+inline int read_int(const Source& src, const json& j, const std::string& ptr, int lo, int hi,
+             const std::string& expected) {
+  if (!j.is_number()) fail_type(src, ptr, j, expected);
+  const double v = j.get<double>();
+  if (v != std::floor(v) || v < lo || v > hi) fail_type(src, ptr, j, expected);
+  return static_cast<int>(v);
+}
+
+inline std::string read_string(const Source& src, const json& j, const std::string& ptr,
+                        const std::string& expected) {
+  if (!j.is_string()) fail_type(src, ptr, j, expected);
+  return j.get<std::string>();
+}
+
+inline std::vector<double> read_numbers(const Source& src, const json& j, const std::string& ptr,
+                                 const std::string& expected) {
+  expect_array(src, j, ptr, expected);
+  std::vector<double> out;
+  out.reserve(j.size());
+  for (std::size_t i = 0; i < j.size(); ++i) out.push_back(read_number_at(src, j[i], ptr, i));
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------
+// Splines
+
+/// What each control point holds, for messages: dim 6, "6 (xyz + 3 properties)".
+struct PointShape {
+  int dim;
+  std::string text;
+};
+
+inline PointShape point_shape(std::size_t properties) {
+  const int dim = 3 + static_cast<int>(properties);
+  if (properties == 0) return {dim, "3 (xyz)"};
+  const std::string props =
+      properties == 1 ? "1 property" : std::to_string(properties) + " properties";
+  return {dim, std::to_string(dim) + " (xyz + " + props + ")"};
+}
+
+template <int P>
+inline std::array<int, P> read_orders(const Source& src, const json& j, const std::string& ptr) {
+  const std::string what = std::to_string(P) + " orders (degree + 1), one per direction";
+  expect_array(src, j, ptr, what);
+  if (j.size() != P)
+    src.fail(ptr, plural(static_cast<std::int64_t>(j.size()), "order") + "; expected " + what);
+  std::array<int, P> orders{};
+  for (int d = 0; d < P; ++d)
+    orders[d] = read_int(src, j[d], child(ptr, d), 1, INT_MAX,
+                         "an integer order (degree + 1) of at least 1");
+  return orders;
+}
+
+inline KnotVector read_knot_vector(const Source& src, const json& j, const std::string& ptr, int order) {
+  std::vector<double> knots = read_numbers(src, j, ptr, "an array of knots");
+  for (std::size_t i = 1; i < knots.size(); ++i)
+    if (knots[i] < knots[i - 1])
+      src.fail(child(ptr, i), "knot " + format_double(knots[i]) + " is less than knot " +
+                                  std::to_string(i - 1) + " (" + format_double(knots[i - 1]) +
+                                  "); expected non-decreasing knots");
+  // Checked here, in 64 bits, so that KnotVector never computes 2 * order from a huge order.
+  const auto needed = 2 * static_cast<std::int64_t>(order);
+  if (static_cast<std::int64_t>(knots.size()) < needed)
+    src.fail(ptr, plural(static_cast<std::int64_t>(knots.size()), "knot") + " for order " +
+                      std::to_string(order) + "; expected at least " + std::to_string(needed) +
+                      " (control points + order, with at least order control points)");
+  try {
+    return KnotVector(order, std::move(knots));
+  } catch (const Error& e) {
+    throw e.within(src.at(ptr));
+  }
+}
+
+/// Product of the counts, saturating: absurd counts must give a message, not an overflow.
+inline std::int64_t saturating_product(std::int64_t a, std::int64_t b) {
+  return (b != 0 && a > INT64_MAX / b) ? INT64_MAX : a * b;
+}
+
+inline std::vector<double> read_points(const Source& src, const json& j, const std::string& ptr,
+                                std::int64_t count, const std::string& count_text,
+                                const PointShape& shape) {
+  const std::string row_what = "a control point: an array of " + shape.text + " numbers";
+  expect_array(src, j, ptr, "an array of control points, each " + row_what);
+  if (static_cast<std::int64_t>(j.size()) != count)
+    src.fail(ptr, plural(static_cast<std::int64_t>(j.size()), "control point") + "; expected " +
+                      count_text);
+  std::vector<double> out;
+  out.reserve(j.size() * static_cast<std::size_t>(shape.dim));
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const json& row = j[i];
+    if (!row.is_array()) fail_type(src, child(ptr, i), row, row_what);
+    if (row.size() != static_cast<std::size_t>(shape.dim))
+      src.fail(child(ptr, i), plural(static_cast<std::int64_t>(row.size()), "coordinate") +
+                                  "; expected " + shape.text);
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (row[k].is_number() && std::isfinite(row[k].get<double>()))
+        out.push_back(row[k].get<double>());
+      else
+        read_number(src, row[k], child(child(ptr, i), k));  // throws with the pointer
+    }
+  }
+  return out;
+}
+
+inline std::vector<double> read_weights(const Source& src, const json* j, const std::string& ptr,
+                                 std::int64_t count) {
+  if (j == nullptr || j->is_null()) return {};
+  std::vector<double> w = read_numbers(src, *j, ptr, "null or an array of positive weights");
+  if (static_cast<std::int64_t>(w.size()) != count)
+    src.fail(ptr, plural(static_cast<std::int64_t>(w.size()), "weight") + "; expected " +
+                      std::to_string(count) + " (one per control point) or null");
+  for (std::size_t i = 0; i < w.size(); ++i)
+    if (!(w[i] > 0))
+      src.fail(child(ptr, i), "weight " + format_double(w[i]) + "; expected a positive weight");
+  return w;
+}
+
+template <int P>
+spline::TensorSpline<P> read_spline(const Source& src, const json& j, const std::string& ptr,
+                                    const PointShape& shape) {
+  const char* kind = P == 3 ? "a trivariate" : P == 2 ? "a surface" : "a curve";
+  const std::string what = std::string(kind) + " {\"orders\", \"knots\", \"points\", \"weights\"}";
+  expect_object(src, j, ptr, what);
+  const auto orders =
+      read_orders<P>(src, require(src, j, ptr, "orders", what), child(ptr, "orders"));
+  const std::string kp = child(ptr, "knots");
+  const json& kj = expect_array(src, require(src, j, ptr, "knots", what), kp,
+                                std::to_string(P) + " knot vectors, one per direction");
+  if (kj.size() != P)
+    src.fail(kp, plural(static_cast<std::int64_t>(kj.size()), "knot vector") + "; expected " +
+                     std::to_string(P) + ", one per direction");
+  std::array<KnotVector, P> knots;
+  std::int64_t count = 1;
+  std::string counts_text;
+  for (int d = 0; d < P; ++d) {
+    knots[d] = read_knot_vector(src, kj[d], child(kp, d), orders[d]);
+    count = saturating_product(count, knots[d].size());
+    counts_text += (d ? " x " : "") + std::to_string(knots[d].size());
+  }
+  const std::string count_text =
+      std::to_string(count) + " (" + counts_text + ", from the knot vectors and orders)";
+  auto points = read_points(src, require(src, j, ptr, "points", what), child(ptr, "points"), count,
+                            count_text, shape);
+  auto weights = read_weights(src, find(j, "weights"), child(ptr, "weights"), count);
+  try {
+    return spline::TensorSpline<P>(std::move(knots), shape.dim, std::move(points),
+                                   std::move(weights));
+  } catch (const Error& e) {
+    throw e.within(src.at(ptr));
+  }
+}
+
+}  // namespace trivox::io::json_read
