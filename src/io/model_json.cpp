@@ -8,7 +8,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "json_read.hpp"
+#include "json_io.hpp"
 
 #include "trivox/error.hpp"
 
@@ -18,7 +18,7 @@ namespace {
 
 constexpr std::array<std::string_view, 5> units_list = {"um", "mm", "cm", "m", "in"};
 
-using namespace json_read;
+using namespace json_io;
 
 // ------------------------------------------------------------------------------------------
 // The model
@@ -159,46 +159,6 @@ void check_writable(const vmodel::VModel& m) {
   NameTable names;
   for (const auto& c : m.cells) check_item(c.name, c.volume, shape, names);
   for (const auto& s : m.surfaces) check_item(s.name, s.surface, shape, names);
-}
-
-void write_numbers(std::string& out, std::span<const double> values) {
-  out += '[';
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (i) out += ", ";
-    out += format_double(values[i]);
-  }
-  out += ']';
-}
-
-/// A spline object at the given indentation, one knot vector and one control point per line,
-/// weights one u-row per line.
-template <int P>
-void write_spline(std::string& out, const spline::TensorSpline<P>& s, const std::string& indent) {
-  const std::string in1 = indent + "  ", in2 = indent + "    ";
-  out += "{\n" + in1 + "\"orders\": [";
-  for (int d = 0; d < P; ++d) out += (d ? ", " : "") + std::to_string(s.knots(d).order());
-  out += "],\n" + in1 + "\"knots\": [";
-  for (int d = 0; d < P; ++d) {
-    out += (d ? ",\n" : "\n") + in2;
-    write_numbers(out, s.knots(d).knots());
-  }
-  out += "\n" + in1 + "],\n" + in1 + "\"points\": [";
-  for (int r = 0; r < s.size(); ++r) {
-    out += (r ? ",\n" : "\n") + in2;
-    write_numbers(out, s.point(r));
-  }
-  out += "\n" + in1 + "],\n" + in1 + "\"weights\": ";
-  if (!s.rational()) {
-    out += "null";
-  } else {
-    const auto row = static_cast<std::size_t>(s.count(0));
-    const std::span<const double> w = s.weights();
-    out += '[';
-    for (std::size_t i = 0; i < w.size(); ++i)
-      out += (i == 0 ? "\n" + in2 : i % row == 0 ? ",\n" + in2 : ", ") + format_double(w[i]);
-    out += "\n" + in1 + "]";
-  }
-  out += "\n" + indent + "}";
 }
 
 template <class Item, class Get>

@@ -1,6 +1,6 @@
-/// @file src/io/json_read.hpp
-/// @brief Private to io: checked reading of JSON documents, shared by the readers of models,
-/// scenes and constructor inputs. Every value's type and range is checked before it is used, and
+/// @file src/io/json_io.hpp
+/// @brief Private to io: checked reading of JSON documents and writing of splines, shared by the
+/// model, scene and constructor files. Every value's type and range is checked before it is used, and
 /// every failure is a trivox::Error (bad_input) reading "<file>: <JSON pointer>: <what was
 /// found>; expected <what>" (or "<file>: line L, column C: malformed JSON: ..." for syntax).
 #pragma once
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,7 +19,7 @@
 #include "trivox/error.hpp"
 #include "trivox/spline/tensor_spline.hpp"
 
-namespace trivox::io::json_read {
+namespace trivox::io::json_io {
 
 using nlohmann::json;
 using spline::KnotVector;
@@ -300,4 +301,47 @@ spline::TensorSpline<P> read_spline(const Source& src, const json& j, const std:
   }
 }
 
-}  // namespace trivox::io::json_read
+// ------------------------------------------------------------------------------------------
+// Writing
+
+inline void write_numbers(std::string& out, std::span<const double> values) {
+  out += '[';
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i) out += ", ";
+    out += format_double(values[i]);
+  }
+  out += ']';
+}
+
+/// A spline object at the given indentation, one knot vector and one control point per line,
+/// weights one u-row per line.
+template <int P>
+inline void write_spline(std::string& out, const spline::TensorSpline<P>& s, const std::string& indent) {
+  const std::string in1 = indent + "  ", in2 = indent + "    ";
+  out += "{\n" + in1 + "\"orders\": [";
+  for (int d = 0; d < P; ++d) out += (d ? ", " : "") + std::to_string(s.knots(d).order());
+  out += "],\n" + in1 + "\"knots\": [";
+  for (int d = 0; d < P; ++d) {
+    out += (d ? ",\n" : "\n") + in2;
+    write_numbers(out, s.knots(d).knots());
+  }
+  out += "\n" + in1 + "],\n" + in1 + "\"points\": [";
+  for (int r = 0; r < s.size(); ++r) {
+    out += (r ? ",\n" : "\n") + in2;
+    write_numbers(out, s.point(r));
+  }
+  out += "\n" + in1 + "],\n" + in1 + "\"weights\": ";
+  if (!s.rational()) {
+    out += "null";
+  } else {
+    const auto row = static_cast<std::size_t>(s.count(0));
+    const std::span<const double> w = s.weights();
+    out += '[';
+    for (std::size_t i = 0; i < w.size(); ++i)
+      out += (i == 0 ? "\n" + in2 : i % row == 0 ? ",\n" + in2 : ", ") + format_double(w[i]);
+    out += "\n" + in1 + "]";
+  }
+  out += "\n" + indent + "}";
+}
+
+}  // namespace trivox::io::json_io
