@@ -9,6 +9,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
@@ -17,6 +18,7 @@
 
 #include "../detail/json_text.hpp"
 #include "trivox/error.hpp"
+#include "trivox/io/model_json.hpp"
 #include "trivox/spline/tensor_spline.hpp"
 
 namespace trivox::io::json_io {
@@ -299,6 +301,63 @@ spline::TensorSpline<P> read_spline(const Source& src, const json& j, const std:
   } catch (const Error& e) {
     throw e.within(src.at(ptr));
   }
+}
+
+// ------------------------------------------------------------------------------------------
+// The header shared by models and scenes: version, units, property names, cell names
+
+/// The model format version (model_json.hpp), required at /trivox.
+inline void check_version(const Source& src, const json& root) {
+  const json& v = require(src, root, "", "trivox",
+                          "\"trivox\": 1 (the model format version) in a trivox model file");
+  if (!v.is_number()) fail_type(src, "/trivox", v, "the format version 1");
+  if (v != model_format_version)
+    src.fail("/trivox", "format version " + v.dump() +
+                            "; expected 1 (this trivox reads model format version 1)");
+}
+
+inline std::string read_units(const Source& src, const json& root) {
+  const json* j = find(root, "units");
+  if (j == nullptr) return "mm";
+  const std::string what = "one of \"um\", \"mm\", \"cm\", \"m\", \"in\"";
+  const std::string units = read_string(src, *j, "/units", what);
+  if (!known_units(units))
+    src.fail("/units", "unknown units " + quote(units) + "; expected " + what);
+  return units;
+}
+
+inline std::vector<std::string> read_properties(const Source& src, const json& root) {
+  const json* j = find(root, "properties");
+  if (j == nullptr || j->is_null()) return {};
+  const std::string what = "a unique non-empty property name";
+  expect_array(src, *j, "/properties", "an array of property names");
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string p = child("/properties", i);
+    std::string name = read_string(src, (*j)[i], p, what);
+    if (name.empty()) src.fail(p, "empty name; expected " + what);
+    for (std::size_t k = 0; k < out.size(); ++k)
+      if (out[k] == name)
+        src.fail(p,
+                 quote(name) + " repeats /properties/" + std::to_string(k) + "; expected " + what);
+    out.push_back(std::move(name));
+  }
+  return out;
+}
+
+/// Names taken so far (cells and surfaces share one namespace), with their owner's pointer.
+using NameTable = std::map<std::string, std::string>;
+
+inline std::string read_name(const Source& src, const json& obj, const std::string& ptr,
+                      NameTable& names) {
+  const std::string what = "a unique non-empty name";
+  const std::string np = child(ptr, "name");
+  std::string name = read_string(src, require(src, obj, ptr, "name", what), np, what);
+  if (name.empty()) src.fail(np, "empty name; expected " + what);
+  const auto [it, fresh] = names.emplace(name, ptr);
+  if (!fresh)
+    src.fail(np, quote(name) + " is also the name of " + it->second + "; expected " + what);
+  return name;
 }
 
 // ------------------------------------------------------------------------------------------
