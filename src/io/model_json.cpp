@@ -41,6 +41,53 @@ void reject_scene(const Source& src, const json& root) {
       src.fail(child(child("/cells", i), "primitive"), scene_message);
 }
 
+vmodel::VCell read_cell(const Source& src, const json& item, const std::string& ip, const PointShape& shape,
+                        NameTable& names, int depth);
+
+/// A trimmed cell's "within" (cell objects), "without" (arrays of cell objects) and "blend"
+/// (vmodel::VCell; written by Boolean operations).
+void read_trims(const Source& src, const json& item, const std::string& ip, const PointShape& shape,
+                vmodel::VCell& cell, int depth) {
+  if (depth > 64) src.fail(ip, "Boolean trimming nested more than 64 deep; expected a shallower model");
+  const std::string cell_what = "a cell object {\"name\", \"trivariate\"}";
+  if (const json* w = find(item, "within")) {
+    const std::string wp = child(ip, "within");
+    expect_array(src, *w, wp, "an array of " + cell_what + " objects");
+    NameTable local;
+    for (std::size_t i = 0; i < w->size(); ++i) cell.within.push_back(read_cell(src, (*w)[i], child(wp, i), shape, local, depth + 1));
+  }
+  if (const json* o = find(item, "without")) {
+    const std::string op = child(ip, "without");
+    expect_array(src, *o, op, "an array of solids, each an array of " + cell_what + " objects");
+    for (std::size_t i = 0; i < o->size(); ++i) {
+      const std::string sp = child(op, i);
+      expect_array(src, (*o)[i], sp, "a solid: an array of " + cell_what + " objects");
+      std::vector<vmodel::VCell> solid;
+      NameTable local;
+      for (std::size_t k = 0; k < (*o)[i].size(); ++k)
+        solid.push_back(read_cell(src, (*o)[i][k], child(sp, k), shape, local, depth + 1));
+      cell.without.push_back(std::move(solid));
+    }
+  }
+  if (const json* b = find(item, "blend")) {
+    const std::string expected = "a blend rule: \"first\", \"sum_clip\" or \"mean\"";
+    const std::string name = read_string(src, *b, child(ip, "blend"), expected);
+    if (!vmodel::blend_rule_from_name(name, cell.blend))
+      src.fail(child(ip, "blend"), "unknown blend rule " + quote(name) + "; expected " + expected);
+  }
+}
+
+vmodel::VCell read_cell(const Source& src, const json& item_in, const std::string& ip, const PointShape& shape,
+                        NameTable& names, int depth) {
+  const std::string what = "{\"name\", \"trivariate\"}";
+  const json& item = expect_object(src, item_in, ip, "an object " + what);
+  std::string name = read_name(src, item, ip, names);
+  vmodel::VCell cell(std::move(name),
+                     read_spline<3>(src, require(src, item, ip, "trivariate", what), child(ip, "trivariate"), shape));
+  read_trims(src, item, ip, shape, cell, depth);
+  return cell;
+}
+
 /// One array of named splines: "cells" (key "trivariate") or "surfaces" (key "surface").
 template <int P, class Item>
 std::vector<Item> read_items(const Source& src, const json& root, const char* list, const char* key,
@@ -58,6 +105,7 @@ std::vector<Item> read_items(const Source& src, const json& root, const char* li
     std::string name = read_name(src, item, ip, names);
     out.push_back({std::move(name),
                    read_spline<P>(src, require(src, item, ip, key, what), child(ip, key), shape)});
+    if constexpr (P == 3) read_trims(src, item, ip, shape, out.back(), 0);
   }
   return out;
 }
@@ -99,13 +147,61 @@ void check_item(const std::string& name, const spline::TensorSpline<P>& s, const
       throw Error(pre + " has weight " + format_double(w) + "; expected positive finite weights");
 }
 
+/// A trimmed cell's nested cells (names unique within each list, as the reader wants).
+void check_trims(const vmodel::VCell& c, const PointShape& shape) {
+  NameTable within;
+  for (const auto& w : c.within) {
+    check_item(w.name, w.volume, shape, within);
+    check_trims(w, shape);
+  }
+  for (const auto& solid : c.without) {
+    NameTable local;
+    for (const auto& o : solid) {
+      check_item(o.name, o.volume, shape, local);
+      check_trims(o, shape);
+    }
+  }
+}
+
 /// Everything the reader would reject, checked before a byte is written.
 void check_writable(const vmodel::VModel& m) {
   check_header(m);
   const PointShape shape = point_shape(m.properties.size());
   NameTable names;
-  for (const auto& c : m.cells) check_item(c.name, c.volume, shape, names);
+  for (const auto& c : m.cells) {
+    check_item(c.name, c.volume, shape, names);
+    check_trims(c, shape);
+  }
   for (const auto& s : m.surfaces) check_item(s.name, s.surface, shape, names);
+}
+
+/// A cell object at the given indentation, with its trimming (nested cells) when it has any.
+void write_cell(std::string& out, const vmodel::VCell& c, const std::string& indent) {
+  const std::string in1 = indent + "  ";
+  out += "{\n" + in1 + "\"name\": " + quote(c.name) + ",\n" + in1 + "\"trivariate\": ";
+  write_spline(out, c.volume, in1);
+  if (!c.within.empty()) {
+    out += ",\n" + in1 + "\"within\": [";
+    for (std::size_t i = 0; i < c.within.size(); ++i) {
+      out += (i ? ", " : "");
+      write_cell(out, c.within[i], in1);
+    }
+    out += "]";
+  }
+  if (!c.without.empty()) {
+    out += ",\n" + in1 + "\"without\": [";
+    for (std::size_t i = 0; i < c.without.size(); ++i) {
+      out += (i ? ", [" : "[");
+      for (std::size_t k = 0; k < c.without[i].size(); ++k) {
+        out += (k ? ", " : "");
+        write_cell(out, c.without[i][k], in1);
+      }
+      out += "]";
+    }
+    out += "]";
+  }
+  if (c.blend != vmodel::BlendRule::first) out += ",\n" + in1 + "\"blend\": " + quote(vmodel::blend_rule_name(c.blend));
+  out += "\n" + indent + "}";
 }
 
 template <class Item, class Get>
@@ -157,8 +253,12 @@ std::string write_model_json(const vmodel::VModel& model) {
   for (std::size_t i = 0; i < model.properties.size(); ++i)
     out += (i ? ", " : "") + quote(model.properties[i]);
   out += "],\n";
-  write_items(out, model.cells, "cells", "trivariate",
-              [](const vmodel::VCell& c) -> const spline::Trivariate& { return c.volume; });
+  out += "  \"cells\": [";
+  for (std::size_t i = 0; i < model.cells.size(); ++i) {
+    out += (i ? ",\n    " : "\n    ");
+    write_cell(out, model.cells[i], "    ");
+  }
+  out += model.cells.empty() ? "],\n" : "\n  ],\n";
   if (!model.surfaces.empty())
     write_items(out, model.surfaces, "surfaces", "surface",
                 [](const vmodel::NamedSurface& s) -> const spline::Surface& { return s.surface; });

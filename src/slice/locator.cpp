@@ -391,7 +391,20 @@ struct Locator::Data {
     int first = 0, count = 0;   ///< range of items for a leaf node
   };
 
+  /// A trimmed cell's conditions (VCell::within, VCell::without), each a locator over its own
+  /// cells; null for plain cells.
+  struct Sub {
+    vmodel::VModel model;
+    std::unique_ptr<Locator> loc;
+  };
+  struct Trim {
+    std::vector<std::unique_ptr<Sub>> within, without;
+    vmodel::BlendRule blend = vmodel::BlendRule::first;
+  };
+
   int m = 0;  ///< properties per point
+  std::vector<std::unique_ptr<Trim>> trims;  ///< per cell
+  bool any_trim = false;
   std::vector<Cell> cells;
   std::vector<Piece> pieces;
   std::vector<double> pool;  ///< every piece's net, control point after control point
@@ -821,6 +834,69 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
     D.cells.push_back(std::move(cb.cell));
   }
   build_bvh(D);
+  // Booleans' trimming: one locator per condition, built recursively (their cells may be
+  // trimmed too).
+  D.trims.resize(static_cast<std::size_t>(nc));
+  for (int c = 0; c < nc; ++c) {
+    const auto& cell = model.cells[static_cast<std::size_t>(c)];
+    if (cell.plain()) continue;
+    auto trim = std::make_unique<Data::Trim>();
+    trim->blend = cell.blend;
+    const auto sub = [&](std::vector<vmodel::VCell> cells) {
+      auto s = std::make_unique<Data::Sub>();
+      s->model.units = model.units;
+      s->model.properties = model.properties;
+      s->model.cells = std::move(cells);
+      s->loc = std::make_unique<Locator>(s->model, opt_);
+      return s;
+    };
+    for (const auto& w : cell.within) trim->within.push_back(sub({w}));
+    for (const auto& solid : cell.without) trim->without.push_back(sub(solid));
+    D.trims[static_cast<std::size_t>(c)] = std::move(trim);
+    D.any_trim = true;
+  }
+}
+
+bool Locator::trimmed(int cell) const noexcept { return data_->trims[static_cast<std::size_t>(cell)] != nullptr; }
+bool Locator::has_trims() const noexcept { return data_->any_trim; }
+
+bool Locator::admits(int cell, const Vec3& p) const {
+  const auto& trim = data_->trims[static_cast<std::size_t>(cell)];
+  if (!trim) return true;
+  for (const auto& w : trim->within)
+    if (!w->loc->locate(p).inside) return false;
+  for (const auto& o : trim->without)
+    if (o->loc->locate(p).inside) return false;
+  return true;
+}
+
+void Locator::blend_properties(int cell, const Vec3& p, double* props) const {
+  const auto& trim = data_->trims[static_cast<std::size_t>(cell)];
+  const int m = data_->m;
+  if (!trim || trim->blend == vmodel::BlendRule::first || m == 0) return;
+  std::vector<double> other(static_cast<std::size_t>(m));
+  int count = 1;
+  for (const auto& w : trim->within) {
+    const auto r = w->loc->locate(p);
+    if (!r.inside) continue;  // only within the tolerance of its boundary
+    double x[3];
+    w->loc->eval(r.cell, r.uvw, x, other.data());
+    w->loc->blend_properties(r.cell, p, other.data());
+    for (int h = 0; h < m; ++h) props[h] += other[static_cast<std::size_t>(h)];
+    ++count;
+  }
+  for (int h = 0; h < m; ++h) {
+    if (trim->blend == vmodel::BlendRule::sum_clip) props[h] = std::clamp(props[h], 0.0, 1.0);
+    else props[h] /= count;
+  }
+}
+
+void Locator::blend_properties(int cell, const Vec3& p, float* props) const {
+  if (!trimmed(cell)) return;
+  const int m = data_->m;
+  std::vector<double> d(props, props + m);
+  blend_properties(cell, p, d.data());
+  for (int h = 0; h < m; ++h) props[h] = static_cast<float>(d[static_cast<std::size_t>(h)]);
 }
 
 Locator::~Locator() = default;
@@ -1080,7 +1156,11 @@ LocateResult Locator::locate(const Vec3& p, const LocateResult* hint) const {
     if (hint && hint->inside && hint->cell == cell) {
       const auto dom = domain(cell);
       const auto r = newton(cell, p, hint->uvw, dom[0], dom[1]);
-      if (r.status == NewtonStatus::converged) return {true, cell, r.uvw, out.converged};
+      if (r.status == NewtonStatus::converged) {
+        if (admits(cell, p)) return {true, cell, r.uvw, out.converged};
+        k = e;  // inside the trivariate but trimmed away: the next cell
+        continue;
+      }
     }
     NewtonResult best;
     best.residual = inf;
@@ -1088,7 +1168,11 @@ LocateResult Locator::locate(const Vec3& p, const LocateResult* hint) const {
     for (std::size_t i = k; i < e; ++i) {
       if (!data_->leaves[static_cast<std::size_t>(cand[i])].may_contain(p, opt_.tolerance)) continue;
       const auto r = solve_in_leaf(cand[i], p);
-      if (r.status == NewtonStatus::converged) return {true, cell, r.uvw, out.converged};
+      if (r.status == NewtonStatus::converged) {
+        if (admits(cell, p)) return {true, cell, r.uvw, out.converged};
+        failed = false;
+        break;
+      }
       if (r.status == NewtonStatus::failed) {
         failed = true;
         if (r.residual < best.residual) best = r;
@@ -1096,7 +1180,7 @@ LocateResult Locator::locate(const Vec3& p, const LocateResult* hint) const {
     }
     if (failed) {
       out.converged = false;
-      if (best.residual < guess) return {true, cell, best.uvw, false};
+      if (best.residual < guess && admits(cell, p)) return {true, cell, best.uvw, false};
     }
     k = e;
   }

@@ -35,8 +35,9 @@
 /// partials (StepBounds), from which the sampler certifies whole runs of voxels without
 /// evaluating them (sampler.hpp).
 ///
-/// Overlapping cells: the first cell in file order that contains p wins (until Booleans define
-/// more). Points within the tolerance of a cell count as inside it.
+/// Overlapping cells: the first cell in file order that contains p wins; cells made by Booleans
+/// are trimmed so that they do not overlap (vmodel/boolean.hpp), and a trimmed cell contains p
+/// only where its conditions admit it. Points within the tolerance of a cell count as inside it.
 ///
 /// Cost: construction O(pieces * leaves per piece * order^3 * dim), parallel over cells (TBB).
 /// A query: a BVH descent plus, per candidate leaf, a few Newton iterations of O(order^3)
@@ -191,13 +192,30 @@ public:
   Locator(Locator&&) noexcept;
   Locator& operator=(Locator&&) noexcept;
 
-  /// Which cell contains p and where; the first cell in file order wins on overlap.
+  /// Which cell contains p and where; the first cell in file order wins on overlap. A trimmed
+  /// cell (a Boolean's, vmodel::VCell::within / without) contains p only when its trivariate
+  /// does and its conditions admit p (admits()).
   /// Thread-safe (const, no mutable state).
   /// @param p     the point, xyz in model units (not finite: outside, with converged == false)
   /// @param hint  optional: a previous answer near p (same cell, its uvw) to warm-start Newton
   LocateResult locate(const Vec3& p, const LocateResult* hint = nullptr) const;
 
   const vmodel::VModel& model() const noexcept;
+
+  // ---- Booleans (seed 003 Sec. 4): trimmed cells ----
+  /// True when some cell is trimmed (not VCell::plain()).
+  bool has_trims() const noexcept;
+  /// True when cell c is trimmed.
+  bool trimmed(int cell) const noexcept;
+  /// Whether p (inside cell c's trivariate) satisfies c's trimming: inside every `within` cell
+  /// and in no cell of any `without` solid, each decided by its own locator (so exactly, up to
+  /// the tolerance). Always true for plain cells.
+  bool admits(int cell, const Vec3& p) const;
+  /// Cell c's properties at p by its blend rule: `props` holds the trivariate's own m values
+  /// on entry; the within cells' values at p (their own blends applied) are combined with them
+  /// (sum clipped to [0, 1], or the mean). Unchanged for plain cells and BlendRule::first.
+  void blend_properties(int cell, const Vec3& p, double* props) const;
+  void blend_properties(int cell, const Vec3& p, float* props) const;
   const LocatorOptions& options() const noexcept;
 
   // ---- Building blocks for the layer sampler (and anyone walking many coherent points) ----

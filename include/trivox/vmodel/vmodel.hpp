@@ -7,16 +7,50 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "trivox/spline/tensor_spline.hpp"
 
 namespace trivox::vmodel {
 
+/// How the properties of a cell that lies in several inputs' cells combine (Booleans,
+/// seed 003 Sec. 3.1.2): the cell's own trivariate and each `within` cell give values at a point.
+enum class BlendRule {
+  first,    ///< the cell's own trivariate alone
+  sum_clip, ///< the sum of all values, clipped to [0, 1] (seed 003 Fig. 5: colours summed)
+  mean,     ///< their average
+};
+
+/// "first", "sum_clip", "mean".
+const char* blend_rule_name(BlendRule r) noexcept;
+/// The rule called `name`, or false.
+bool blend_rule_from_name(std::string_view name, BlendRule& out) noexcept;
+
 /// One volumetric cell: a trivariate in R^(3+m), coordinates 0..2 xyz and 3.. the properties.
+///
+/// A plain cell is the image of its trivariate. A cell made by a Boolean operation (seed 003
+/// Sec. 4, Alg. 1-3) is *trimmed*: it is the part of that image that lies in every `within` cell
+/// and in none of the cells of any `without` list (Def. 3.2: a V-cell is in the intersection of
+/// one or more trivariates; here the trimming is given by the other inputs' cells themselves, so
+/// membership is exact at every point, decided by point inversion). Intersection cells keep the
+/// other input's cell in `within`, with its trivariate and attributes, and blend the
+/// properties by `blend`. The nesting follows the Boolean expression: a `within` cell or a
+/// `without` cell may itself be trimmed.
 struct VCell {
+  VCell() = default;
+  /// A plain cell.
+  VCell(std::string name_, spline::Trivariate volume_) : name(std::move(name_)), volume(std::move(volume_)) {}
+
   std::string name;
   spline::Trivariate volume;
+  std::vector<VCell> within;                ///< the cell also lies in each of these
+  std::vector<std::vector<VCell>> without;  ///< and in no cell of any of these solids
+  BlendRule blend = BlendRule::first;       ///< how volume's and the within cells' properties combine
+
+  /// No trimming: the cell is its trivariate's image.
+  bool plain() const noexcept { return within.empty() && without.empty(); }
 
   bool operator==(const VCell&) const = default;
 };

@@ -1,0 +1,127 @@
+#include "trivox/vmodel/boolean.hpp"
+
+#include <array>
+#include <set>
+
+#include "trivox/error.hpp"
+#include "trivox/spline/extract.hpp"
+
+namespace trivox::vmodel {
+
+namespace {
+
+using Box = std::array<std::array<double, 3>, 2>;
+
+/// A conservative xyz box of a cell's region: its trivariate's box, narrowed to every within
+/// cell's box (the region lies in all of them).
+Box region_box(const VCell& c) {
+  const auto b = spline::bounding_box(c.volume, 3);
+  Box box{{{b[0][0], b[0][1], b[0][2]}, {b[1][0], b[1][1], b[1][2]}}};
+  for (const auto& w : c.within) {
+    const Box wb = region_box(w);
+    for (std::size_t d = 0; d < 3; ++d) {
+      box[0][d] = std::max(box[0][d], wb[0][d]);
+      box[1][d] = std::min(box[1][d], wb[1][d]);
+    }
+  }
+  return box;
+}
+
+bool overlap(const Box& a, const Box& b) {
+  for (std::size_t d = 0; d < 3; ++d)
+    if (a[0][d] > b[1][d] || b[0][d] > a[1][d] || a[0][d] > a[1][d] || b[0][d] > b[1][d]) return false;
+  return true;
+}
+
+void check_compatible(const VModel& a, const VModel& b, BooleanOp op) {
+  const std::string what = std::string(boolean_op_name(op)) + " of two models";
+  if (a.cells.empty() || b.cells.empty())
+    throw Error(what + ": the " + (a.cells.empty() ? "first" : "second") +
+                " model has no cells; expected volumetric cells in both");
+  if (a.properties != b.properties) {
+    auto list = [](const std::vector<std::string>& p) {
+      std::string s = "[";
+      for (std::size_t i = 0; i < p.size(); ++i) s += (i ? ", " : "") + p[i];
+      return s + "]";
+    };
+    throw Error(what + ": properties " + list(a.properties) + " and " + list(b.properties) +
+                "; expected the same property names in the same order");
+  }
+  if (a.units != b.units)
+    throw Error(what + ": units " + a.units + " and " + b.units + "; expected the same units");
+}
+
+/// a - (the cells of b that may meet a), or a itself when none can.
+VCell minus(const VCell& a, const std::vector<VCell>& b, const std::vector<Box>& b_boxes) {
+  const Box ab = region_box(a);
+  std::vector<VCell> near;
+  for (std::size_t j = 0; j < b.size(); ++j)
+    if (overlap(ab, b_boxes[j])) near.push_back(b[j]);
+  VCell out = a;
+  if (!near.empty()) out.without.push_back(std::move(near));
+  return out;
+}
+
+class Names {
+public:
+  std::string unique(const std::string& name) {
+    std::string n = name;
+    for (int k = 2; !used_.insert(n).second; ++k) n = name + "." + std::to_string(k);
+    return n;
+  }
+
+private:
+  std::set<std::string> used_;
+};
+
+}  // namespace
+
+const char* boolean_op_name(BooleanOp op) noexcept {
+  switch (op) {
+    case BooleanOp::union_op: return "union";
+    case BooleanOp::intersection: return "intersection";
+    case BooleanOp::subtraction: return "subtraction";
+  }
+  return "union";
+}
+
+VModel boolean(const VModel& a, const VModel& b, BooleanOp op, const BooleanOptions& options) {
+  check_compatible(a, b, op);
+  std::vector<Box> a_boxes, b_boxes;
+  for (const auto& c : a.cells) a_boxes.push_back(region_box(c));
+  for (const auto& c : b.cells) b_boxes.push_back(region_box(c));
+  VModel out;
+  out.units = a.units;
+  out.properties = a.properties;
+  out.surfaces = a.surfaces;
+  out.surfaces.insert(out.surfaces.end(), b.surfaces.begin(), b.surfaces.end());
+  Names names;
+  // Alg. 1: every pair of cells whose boxes meet; the first input's trivariate carries the
+  // geometry, the second rides along in `within`.
+  if (op != BooleanOp::subtraction)
+    for (std::size_t i = 0; i < a.cells.size(); ++i)
+      for (std::size_t j = 0; j < b.cells.size(); ++j) {
+        if (!overlap(a_boxes[i], b_boxes[j])) continue;
+        VCell c = a.cells[i];
+        c.name = names.unique(a.cells[i].name + options.join + b.cells[j].name);
+        c.within.push_back(b.cells[j]);
+        c.blend = options.blend;
+        out.cells.push_back(std::move(c));
+      }
+  // Alg. 2: A - B (and, for the union, B - A), each cell minus the whole other model.
+  if (op != BooleanOp::intersection)
+    for (const auto& c : a.cells) {
+      VCell d = minus(c, b.cells, b_boxes);
+      d.name = names.unique(c.name);
+      out.cells.push_back(std::move(d));
+    }
+  if (op == BooleanOp::union_op)
+    for (const auto& c : b.cells) {
+      VCell d = minus(c, a.cells, a_boxes);
+      d.name = names.unique(c.name);
+      out.cells.push_back(std::move(d));
+    }
+  return out;
+}
+
+}  // namespace trivox::vmodel
