@@ -70,10 +70,28 @@ void read_trims(const Source& src, const json& item, const std::string& ip, cons
     }
   }
   if (const json* b = find(item, "blend")) {
-    const std::string expected = "a blend rule: \"first\", \"sum_clip\" or \"mean\"";
+    const std::string expected = "a blend rule: \"first\", \"sum_clip\", \"mean\" or \"distance\"";
     const std::string name = read_string(src, *b, child(ip, "blend"), expected);
     if (!vmodel::blend_rule_from_name(name, cell.blend))
       src.fail(child(ip, "blend"), "unknown blend rule " + quote(name) + "; expected " + expected);
+  }
+  if (const json* k = find(item, "blend_power")) {
+    cell.blend_power = read_number(src, *k, child(ip, "blend_power"));
+    if (!(cell.blend_power > 0))
+      src.fail(child(ip, "blend_power"), "power " + format_double(cell.blend_power) + "; expected a positive power");
+  }
+  if (const json* b = find(item, "boundaries")) {
+    const std::string bp = child(ip, "boundaries");
+    const std::string list_what = "an array of boundary surfaces, each {\"orders\", \"knots\", \"points\"} in xyz";
+    expect_array(src, *b, bp, "one " + list_what.substr(3) + " per blended value");
+    for (std::size_t i = 0; i < b->size(); ++i) {
+      const std::string lp = child(bp, i);
+      expect_array(src, (*b)[i], lp, list_what);
+      std::vector<spline::Surface> list;
+      for (std::size_t k = 0; k < (*b)[i].size(); ++k)
+        list.push_back(read_spline<2>(src, (*b)[i][k], child(lp, k), PointShape{3, "3 (xyz)"}));
+      cell.boundaries.push_back(std::move(list));
+    }
   }
 }
 
@@ -149,6 +167,17 @@ void check_item(const std::string& name, const spline::TensorSpline<P>& s, const
 
 /// A trimmed cell's nested cells (names unique within each list, as the reader wants).
 void check_trims(const vmodel::VCell& c, const PointShape& shape) {
+  if (!(c.blend_power > 0) || !std::isfinite(c.blend_power))
+    throw Error(cannot_write + quote(c.name) + " has blend power " + format_double(c.blend_power) +
+                "; expected a positive power");
+  for (const auto& list : c.boundaries)
+    for (const auto& f : list) {
+      if (f.dim() != 3)
+        throw Error(cannot_write + quote(c.name) + " has a boundary surface with " + plural(f.dim(), "coordinate") +
+                    "; expected 3 (xyz)");
+      for (double v : f.points())
+        if (!std::isfinite(v)) throw Error(cannot_write + quote(c.name) + " has a non-finite boundary; expected finite numbers");
+    }
   NameTable within;
   for (const auto& w : c.within) {
     check_item(w.name, w.volume, shape, within);
@@ -201,6 +230,19 @@ void write_cell(std::string& out, const vmodel::VCell& c, const std::string& ind
     out += "]";
   }
   if (c.blend != vmodel::BlendRule::first) out += ",\n" + in1 + "\"blend\": " + quote(vmodel::blend_rule_name(c.blend));
+  if (c.blend_power != 1.0) out += ",\n" + in1 + "\"blend_power\": " + format_double(c.blend_power);
+  if (!c.boundaries.empty()) {
+    out += ",\n" + in1 + "\"boundaries\": [";
+    for (std::size_t i = 0; i < c.boundaries.size(); ++i) {
+      out += (i ? ", [" : "[");
+      for (std::size_t k = 0; k < c.boundaries[i].size(); ++k) {
+        out += (k ? ", " : "");
+        write_spline(out, c.boundaries[i][k], in1);
+      }
+      out += "]";
+    }
+    out += "]";
+  }
   out += "\n" + indent + "}";
 }
 

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "trivox/error.hpp"
+#include "trivox/geom/closest_point.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/spline/refine.hpp"
 
@@ -400,6 +401,9 @@ struct Locator::Data {
   struct Trim {
     std::vector<std::unique_ptr<Sub>> within, without;
     vmodel::BlendRule blend = vmodel::BlendRule::first;
+    double power = 1.0;
+    /// BlendRule::distance: per blended value, its input's boundary (empty otherwise).
+    std::vector<std::vector<geom::SurfaceDistance>> boundaries;
   };
 
   int m = 0;  ///< properties per point
@@ -852,6 +856,19 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
     };
     for (const auto& w : cell.within) trim->within.push_back(sub({w}));
     for (const auto& solid : cell.without) trim->without.push_back(sub(solid));
+    if (cell.blend == vmodel::BlendRule::distance) {
+      // Without one boundary per value the distances are undefined: the plain mean then.
+      if (cell.boundaries.size() != 1 + cell.within.size()) {
+        trim->blend = vmodel::BlendRule::mean;
+      } else {
+        trim->power = cell.blend_power;
+        for (const auto& list : cell.boundaries) {
+          std::vector<geom::SurfaceDistance> d;
+          for (const auto& f : list) d.emplace_back(f);
+          trim->boundaries.push_back(std::move(d));
+        }
+      }
+    }
     D.trims[static_cast<std::size_t>(c)] = std::move(trim);
     D.any_trim = true;
   }
@@ -875,6 +892,33 @@ void Locator::blend_properties(int cell, const Vec3& p, double* props) const {
   const int m = data_->m;
   if (!trim || trim->blend == vmodel::BlendRule::first || m == 0) return;
   std::vector<double> other(static_cast<std::size_t>(m));
+  if (trim->blend == vmodel::BlendRule::distance) {
+    // Seed 003 Eq. 2: sum_i d_i^k A_i / sum_i d_i^k, d_i the distance to input i's boundary.
+    std::vector<double> acc(static_cast<std::size_t>(m), 0.0), mean(props, props + m);
+    const auto weight = [&](std::size_t i) { return std::pow(geom::distance(trim->boundaries[i], p), trim->power); };
+    double wsum = weight(0);
+    for (int h = 0; h < m; ++h) acc[static_cast<std::size_t>(h)] = wsum * props[h];
+    int count = 1;
+    for (std::size_t k = 0; k < trim->within.size(); ++k) {
+      const auto& w = trim->within[k];
+      const auto r = w->loc->locate(p);
+      if (!r.inside) continue;
+      double x[3];
+      w->loc->eval(r.cell, r.uvw, x, other.data());
+      w->loc->blend_properties(r.cell, p, other.data());
+      const double wk = weight(k + 1);
+      wsum += wk;
+      ++count;
+      for (int h = 0; h < m; ++h) {
+        acc[static_cast<std::size_t>(h)] += wk * other[static_cast<std::size_t>(h)];
+        mean[static_cast<std::size_t>(h)] += other[static_cast<std::size_t>(h)];
+      }
+    }
+    // On every input's boundary at once (Eq. 2's singular points): the plain mean.
+    for (int h = 0; h < m; ++h)
+      props[h] = wsum > 0 ? acc[static_cast<std::size_t>(h)] / wsum : mean[static_cast<std::size_t>(h)] / count;
+    return;
+  }
   int count = 1;
   for (const auto& w : trim->within) {
     const auto r = w->loc->locate(p);

@@ -1,10 +1,13 @@
 #include "trivox/vmodel/boolean.hpp"
 
 #include <array>
+#include <cmath>
 #include <set>
 
 #include "trivox/error.hpp"
+#include "trivox/spline/calculus.hpp"
 #include "trivox/spline/extract.hpp"
+#include "trivox/vmodel/topology.hpp"
 
 namespace trivox::vmodel {
 
@@ -62,6 +65,16 @@ VCell minus(const VCell& a, const std::vector<VCell>& b, const std::vector<Box>&
   return out;
 }
 
+/// The faces of m's cells glued to no other cell, as xyz surfaces.
+std::vector<spline::Surface> boundary_of(const VModel& m) {
+  const Topology topo = build_topology(m);
+  std::vector<spline::Surface> out;
+  for (const auto& h : topo.half_v_surfaces)
+    if (h.twin < 0)
+      out.push_back(spline::coordinates(spline::boundary_face(m.cells[static_cast<std::size_t>(h.cell)].volume, h.face), 0, 3));
+  return out;
+}
+
 class Names {
 public:
   std::string unique(const std::string& name) {
@@ -87,6 +100,12 @@ const char* boolean_op_name(BooleanOp op) noexcept {
 
 VModel boolean(const VModel& a, const VModel& b, BooleanOp op, const BooleanOptions& options) {
   check_compatible(a, b, op);
+  if (options.blend == BlendRule::distance && !(options.power > 0 && std::isfinite(options.power)))
+    throw Error(std::string(boolean_op_name(op)) + ": distance blend power " + std::to_string(options.power) +
+                "; expected a positive power");
+  const bool distance = options.blend == BlendRule::distance && op != BooleanOp::subtraction;
+  const std::vector<spline::Surface> a_boundary = distance ? boundary_of(a) : std::vector<spline::Surface>{};
+  const std::vector<spline::Surface> b_boundary = distance ? boundary_of(b) : std::vector<spline::Surface>{};
   std::vector<Box> a_boxes, b_boxes;
   for (const auto& c : a.cells) a_boxes.push_back(region_box(c));
   for (const auto& c : b.cells) b_boxes.push_back(region_box(c));
@@ -104,6 +123,14 @@ VModel boolean(const VModel& a, const VModel& b, BooleanOp op, const BooleanOpti
         if (!overlap(a_boxes[i], b_boxes[j])) continue;
         VCell c = a.cells[i];
         c.name = names.unique(a.cells[i].name + options.join + b.cells[j].name);
+        if (distance) {
+          // One boundary per blended value: a's own (kept when a was blended so before), then b's.
+          const auto& ai = a.cells[i];
+          if (!(ai.blend == BlendRule::distance && ai.boundaries.size() == 1 + ai.within.size()))
+            c.boundaries.assign(1 + ai.within.size(), a_boundary);
+          c.boundaries.push_back(b_boundary);
+          c.blend_power = options.power;
+        }
         c.within.push_back(b.cells[j]);
         c.blend = options.blend;
         out.cells.push_back(std::move(c));

@@ -40,6 +40,14 @@ TEST_CASE("trimmed cells round-trip through the model file", "[model_json][boole
   CHECK(back.cells[0].without[0][0].blend == vmodel::BlendRule::mean);
   CHECK(back.cells[0].without[0][0].within.size() == 1);
   CHECK(io::write_model_json(back) == text);
+  // The distance blend keeps its power and both inputs' boundary faces (6 each).
+  const auto d = vmodel::boolean(box("a", 0, 2, 0.1), box("b", 1, 3, 0.2), BooleanOp::intersection,
+                                 {.blend = vmodel::BlendRule::distance, .power = 2.5});
+  const auto dback = io::read_model_json(io::write_model_json(d), "d.json");
+  CHECK(dback == d);
+  REQUIRE(dback.cells[0].boundaries.size() == 2);
+  CHECK(dback.cells[0].boundaries[1].size() == 6);
+  CHECK(dback.cells[0].blend_power == 2.5);
 }
 
 TEST_CASE("malformed trimming is reported with its JSON pointer", "[model_json][boolean]") {

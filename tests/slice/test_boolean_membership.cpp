@@ -182,3 +182,38 @@ TEST_CASE("Booleans refuse models that cannot be combined", "[boolean]") {
   CHECK(u.cells[1].name == "A");
   CHECK(u.cells[2].name == "A.2");
 }
+
+TEST_CASE("the distance blend of seed 003 Eq. 2 weights each input by its boundary distance", "[boolean]") {
+  const std::array<double, 3> a0{0, 0, 0}, a1{2, 1, 1}, b0{1, 0, 0}, b1{3, 1, 1};
+  for (double k : {1.0, 2.0}) {
+    const VModel I = vmodel::boolean(box("A", a0, a1, 0.0), box("B", b0, b1, 1.0), BooleanOp::intersection,
+                                     {.blend = vmodel::BlendRule::distance, .power = k});
+    REQUIRE(I.cells.size() == 1);
+    REQUIRE(I.cells[0].boundaries.size() == 2);
+    CHECK(I.cells[0].boundaries[0].size() == 6);
+    const slice::Locator loc(I, {.tolerance = 1e-9});
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    for (int n = 0; n < 300; ++n) {
+      const slice::Vec3 p{1 + U(rng), U(rng), U(rng)};
+      const double dA = std::min({p[0], 2 - p[0], p[1], 1 - p[1], p[2], 1 - p[2]});
+      const double dB = std::min({p[0] - 1, 3 - p[0], p[1], 1 - p[1], p[2], 1 - p[2]});
+      const double expect = std::pow(dB, k) / (std::pow(dA, k) + std::pow(dB, k));
+      const auto r = loc.locate(p);
+      REQUIRE(r.inside);
+      double x[3], v[1];
+      loc.eval(r.cell, r.uvw, x, v);
+      loc.blend_properties(r.cell, p, v);
+      CHECK(v[0] == Approx(expect).margin(1e-9));
+    }
+    // On A's boundary inside B only B's value remains (C0 with B - A), and vice versa.
+    for (auto [p, expect] : {std::pair{slice::Vec3{2.0, 0.5, 0.5}, 1.0}, std::pair{slice::Vec3{1.0, 0.5, 0.5}, 0.0}}) {
+      const auto r = loc.locate(p);
+      REQUIRE(r.inside);
+      double x[3], v[1];
+      loc.eval(r.cell, r.uvw, x, v);
+      loc.blend_properties(r.cell, p, v);
+      CHECK(v[0] == Approx(expect).margin(1e-9));
+    }
+  }
+}

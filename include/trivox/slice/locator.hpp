@@ -213,7 +213,8 @@ public:
   bool admits(int cell, const Vec3& p) const;
   /// Cell c's properties at p by its blend rule: `props` holds the trivariate's own m values
   /// on entry; the within cells' values at p (their own blends applied) are combined with them
-  /// (sum clipped to [0, 1], or the mean). Unchanged for plain cells and BlendRule::first.
+  /// (sum clipped to [0, 1], the mean, or seed 003 Eq. 2's distance weights: one closest-point
+  /// query per boundary surface of each input). Unchanged for plain cells and BlendRule::first.
   void blend_properties(int cell, const Vec3& p, double* props) const;
   void blend_properties(int cell, const Vec3& p, float* props) const;
   const LocatorOptions& options() const noexcept;

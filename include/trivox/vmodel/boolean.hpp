@@ -13,7 +13,10 @@
 /// not as trimming surfaces: whether a point belongs to a cell is then decided exactly by point
 /// inversion in those cells (slice::Locator), which is what the slicer needs. Pairs whose
 /// bounding boxes are disjoint are dropped from intersections and not listed in subtractions,
-/// so the result stays small for models that touch only locally.
+/// so the result stays small for models that touch only locally. The distance blend (Eq. 2)
+/// stores each input's boundary: the faces of its cells that are glued to no other cell
+/// (vmodel/topology.hpp); for an input that is itself trimmed these are its trivariates' free
+/// faces, an approximation of its true boundary.
 ///
 /// Cost: O(|A| * |B|) box tests; the result holds copies of the trivariates it refers to.
 #pragma once
@@ -31,6 +34,8 @@ const char* boolean_op_name(BooleanOp op) noexcept;
 struct BooleanOptions {
   /// How intersection cells blend the two inputs' properties.
   BlendRule blend = BlendRule::sum_clip;
+  /// k of the distance blend (seed 003 Eq. 2 with d^k), > 0.
+  double power = 1.0;
   /// Names of the result's cells: intersection cells are "<a><join><b>"; cells of A - B and
   /// B - A keep their names. Repeated names get a suffix ".2", ".3", ...
   std::string join = "&";
@@ -39,7 +44,7 @@ struct BooleanOptions {
 /// The Boolean operation `op` of models a and b (same property names in the same order, same
 /// units).
 /// @throws trivox::Error (bad_input) naming the difference when the properties or units differ,
-///         or when either model has no cells
+///         when either model has no cells, or for a distance blend power <= 0
 VModel boolean(const VModel& a, const VModel& b, BooleanOp op, const BooleanOptions& options = {});
 
 }  // namespace trivox::vmodel

@@ -21,9 +21,16 @@ enum class BlendRule {
   first,    ///< the cell's own trivariate alone
   sum_clip, ///< the sum of all values, clipped to [0, 1] (seed 003 Fig. 5: colours summed)
   mean,     ///< their average
+  /// Seed 003 Eq. 2: the average weighted by d_i^k, d_i the distance from the point to the
+  /// boundary of the input model that value i comes from (VCell::boundaries), k = blend_power.
+  /// On the boundary of one input, the other inputs' values alone remain, so the attribute is C0
+  /// across the intersection cell's boundary. (Eq. 2 measures the distance to the part of that
+  /// boundary inside the other input; the whole boundary vanishes on the same parts of the
+  /// cell's boundary, so continuity is the same, only the interior weights differ.)
+  distance,
 };
 
-/// "first", "sum_clip", "mean".
+/// "first", "sum_clip", "mean", "distance".
 const char* blend_rule_name(BlendRule r) noexcept;
 /// The rule called `name`, or false.
 bool blend_rule_from_name(std::string_view name, BlendRule& out) noexcept;
@@ -48,6 +55,10 @@ struct VCell {
   std::vector<VCell> within;                ///< the cell also lies in each of these
   std::vector<std::vector<VCell>> without;  ///< and in no cell of any of these solids
   BlendRule blend = BlendRule::first;       ///< how volume's and the within cells' properties combine
+  double blend_power = 1.0;                 ///< k of BlendRule::distance (> 0)
+  /// BlendRule::distance: one list of boundary surfaces (xyz) per blended value: the input
+  /// model that `volume` came from, then that of each within cell.
+  std::vector<std::vector<spline::Surface>> boundaries;
 
   /// No trimming: the cell is its trivariate's image.
   bool plain() const noexcept { return within.empty() && without.empty(); }

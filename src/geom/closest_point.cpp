@@ -1,0 +1,142 @@
+#include "trivox/geom/closest_point.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "trivox/error.hpp"
+
+namespace trivox::geom {
+
+namespace {
+
+double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/// Parameters of `samples` per span of kv, ends included.
+std::vector<double> sample_params(const spline::KnotVector& kv, int samples) {
+  std::vector<double> t;
+  const auto br = kv.breakpoints();
+  for (std::size_t s = 0; s + 1 < br.size(); ++s) {
+    const double a = br[s].value, b = br[s + 1].value;
+    for (int k = 0; k < samples; ++k) t.push_back(a + (b - a) * k / samples);
+  }
+  t.push_back(kv.back());
+  return t;
+}
+
+}  // namespace
+
+SurfaceDistance::SurfaceDistance(spline::Surface surface, int samples_per_span) : surface_(std::move(surface)) {
+  if (surface_.dim() < 3)
+    throw Error("closest point on a surface with " + std::to_string(surface_.dim()) +
+                " coordinates; expected at least 3 (xyz)");
+  samples_per_span = std::max(2, samples_per_span);
+  const auto us = sample_params(surface_.knots(0), samples_per_span);
+  const auto vs = sample_params(surface_.knots(1), samples_per_span);
+  std::vector<double> x(static_cast<std::size_t>(surface_.dim()));
+  for (double v : vs)
+    for (double u : us) {
+      surface_.eval({u, v}, x.data());
+      uv_.push_back({u, v});
+      xyz_.push_back({x[0], x[1], x[2]});
+    }
+}
+
+ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p) const {
+  // The three nearest samples start Newton; the best answer wins.
+  std::array<std::size_t, 3> best{0, 0, 0};
+  std::array<double, 3> best_d{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                               std::numeric_limits<double>::infinity()};
+  for (std::size_t i = 0; i < xyz_.size(); ++i) {
+    const double dx = xyz_[i][0] - p[0], dy = xyz_[i][1] - p[1], dz = xyz_[i][2] - p[2];
+    const double d = dx * dx + dy * dy + dz * dz;
+    if (d < best_d[2]) {
+      std::size_t k = 2;
+      while (k > 0 && d < best_d[k - 1]) {
+        best_d[k] = best_d[k - 1];
+        best[k] = best[k - 1];
+        --k;
+      }
+      best_d[k] = d;
+      best[k] = i;
+    }
+  }
+  const auto du = surface_.domain(0), dv = surface_.domain(1);
+  const double lo[2] = {du[0], dv[0]}, hi[2] = {du[1], dv[1]};
+  const int dim = surface_.dim();
+  std::vector<double> buf(static_cast<std::size_t>(6 * dim)), val(static_cast<std::size_t>(dim));
+  const auto f_at = [&](const std::array<double, 2>& t) {
+    surface_.eval(t, val.data());
+    const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
+    return dot3(r, r);
+  };
+  ClosestPoint out;
+  out.distance = std::numeric_limits<double>::infinity();
+  const std::size_t starts = std::min<std::size_t>(3, xyz_.size());
+  for (std::size_t s = 0; s < starts; ++s) {
+    std::array<double, 2> t = uv_[best[s]];
+    double f = best_d[s];
+    for (int it = 0; it < 40; ++it) {
+      surface_.eval_derivatives(t, 2, buf.data());
+      const double* S = buf.data();
+      const double* Su = S + dim;
+      const double* Sv = S + 2 * dim;
+      const double* Suu = S + 3 * dim;
+      const double* Suv = S + 4 * dim;
+      const double* Svv = S + 5 * dim;
+      const double r[3] = {S[0] - p[0], S[1] - p[1], S[2] - p[2]};
+      const double g[2] = {dot3(r, Su), dot3(r, Sv)};
+      double H[2][2] = {{dot3(Su, Su) + dot3(r, Suu), dot3(Su, Sv) + dot3(r, Suv)},
+                        {0.0, dot3(Sv, Sv) + dot3(r, Svv)}};
+      H[1][0] = H[0][1];
+      if (!(H[0][0] > 0 && H[0][0] * H[1][1] - H[0][1] * H[0][1] > 0)) {  // Gauss-Newton away from convexity
+        H[0][0] = dot3(Su, Su);
+        H[1][1] = dot3(Sv, Sv);
+        H[0][1] = H[1][0] = dot3(Su, Sv);
+      }
+      // Coordinates at a bound whose descent direction leaves the domain are frozen.
+      bool frozen[2] = {false, false};
+      for (int d = 0; d < 2; ++d)
+        frozen[d] = (t[static_cast<std::size_t>(d)] <= lo[d] && g[d] > 0) || (t[static_cast<std::size_t>(d)] >= hi[d] && g[d] < 0);
+      double step[2] = {0.0, 0.0};
+      if (!frozen[0] && !frozen[1]) {
+        const double det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
+        if (std::abs(det) > 0) {
+          step[0] = -(H[1][1] * g[0] - H[0][1] * g[1]) / det;
+          step[1] = -(H[0][0] * g[1] - H[1][0] * g[0]) / det;
+        }
+      } else {
+        for (int d = 0; d < 2; ++d)
+          if (!frozen[d] && H[d][d] > 0) step[d] = -g[d] / H[d][d];
+      }
+      double lambda = 1.0;
+      std::array<double, 2> next{};
+      double fn = f;
+      for (int h = 0; h < 30; ++h, lambda *= 0.5) {
+        for (std::size_t d = 0; d < 2; ++d) next[d] = std::clamp(t[d] + lambda * step[d], lo[d], hi[d]);
+        fn = f_at(next);
+        if (fn <= f) break;
+      }
+      const double moved = std::abs(next[0] - t[0]) / (hi[0] - lo[0]) + std::abs(next[1] - t[1]) / (hi[1] - lo[1]);
+      if (!(fn <= f)) break;  // no descent: t is stationary to working precision
+      t = next;
+      f = fn;
+      if (moved < 1e-15) break;
+    }
+    if (std::sqrt(f) < out.distance) {
+      surface_.eval(t, val.data());
+      out.uv = t;
+      out.point = {val[0], val[1], val[2]};
+      out.distance = std::sqrt(f);
+    }
+  }
+  return out;
+}
+
+double distance(const std::vector<SurfaceDistance>& surfaces, const std::array<double, 3>& p) {
+  double d = std::numeric_limits<double>::infinity();
+  for (const auto& s : surfaces) d = std::min(d, s.closest(p).distance);
+  return d;
+}
+
+}  // namespace trivox::geom
