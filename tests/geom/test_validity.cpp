@@ -142,3 +142,30 @@ TEST_CASE("rational cells are refused with a reason", "[validity]") {
     CHECK_THAT(e.what(), Catch::Contains("rational"));
   }
 }
+
+TEST_CASE("seed 003 Fig. 1b: interior control points pushed out of the cuboid are found invalid there", "[validity]") {
+  // A triquadratic B-spline unit cube (5 x 5 x 5 control points at the Greville abscissae, so
+  // X(u,v,w) = (u,v,w) and det J = 1), then three interior control points of the top inner
+  // layer (k = 3) pushed up and out of the cuboid to z = 2.5.
+  const KnotVector kv(3, {0, 0, 0, 1.0 / 3, 2.0 / 3, 1, 1, 1});
+  const auto g = kv.greville();
+  std::vector<double> pts;
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 5; ++i) pts.insert(pts.end(), {g[i], g[j], g[k]});
+  Trivariate cube({kv, kv, kv}, 3, pts);
+  REQUIRE(geom::check_validity(cube).verdict == geom::Validity::valid);
+  for (auto [i, j] : {std::pair{1, 2}, std::pair{2, 2}, std::pair{2, 1}}) cube.point(cube.row({i, j, 3}))[2] = 2.5;
+  const auto r = geom::check_validity(cube);
+  CHECK(r.verdict == geom::Validity::invalid);
+  REQUIRE(r.invalid_at);
+  const auto t = *r.invalid_at;
+  INFO("invalid at (" << t[0] << ", " << t[1] << ", " << t[2] << "), det " << r.det_at_invalid);
+  // The place: where the moved points act (their basis functions' supports: u, v in (0, 1),
+  // w in the last two spans, (1/3, 1]), with det J <= 0 by an independent evaluation.
+  CHECK(t[2] > 1.0 / 3);
+  CHECK(det_at(cube, t) <= 1e-9);
+  CHECK(r.det_at_invalid <= 0.0);
+  // Elsewhere the cell is untouched: det J = 1 where no moved point acts (w < 1/3).
+  CHECK(det_at(cube, {0.5, 0.5, 0.2}) == Approx(1.0));
+}
