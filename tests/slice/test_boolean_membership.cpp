@@ -11,7 +11,10 @@
 
 #include "trivox/construct/constructors.hpp"
 #include "trivox/error.hpp"
+#include "trivox/geom/quadrature.hpp"
 #include "trivox/slice/locator.hpp"
+#include "trivox/slice/trim.hpp"
+#include "trivox/vmodel/topology.hpp"
 #include "trivox/vmodel/boolean.hpp"
 
 using namespace trivox;
@@ -216,4 +219,52 @@ TEST_CASE("the distance blend of seed 003 Eq. 2 weights each input by its bounda
       CHECK(v[0] == Approx(expect).margin(1e-9));
     }
   }
+}
+
+TEST_CASE("seed 003 Fig. 3: two boxes united give three box cells with the stated topology", "[boolean]") {
+  // O1 = [0,2]x[0,1]x[0,1], O2 = [1,2]x[0,1]x[0,2]: cells A = O1 - O2, B = O1 n O2, C = O2 - O1.
+  // Paper: 3 V-cells, 2 internal and 14 boundary V-surfaces (16), 18 half-V-surfaces,
+  // 28 V-curves, 16 V-points.
+  const std::array<double, 3> a0{0, 0, 0}, a1{2, 1, 1}, b0{1, 0, 0}, b1{2, 1, 2};
+  const VModel U = vmodel::boolean(box("O1", a0, a1, 0.25), box("O2", b0, b1, 0.5), BooleanOp::union_op);
+  // The trimmed cells' volumes before untrimming: each piece is a unit cube.
+  {
+    const slice::Locator loc(U, {.tolerance = 1e-9});
+    for (int c = 0; c < 3; ++c) CHECK(slice::trimmed_volume(loc, c) == Approx(1.0).epsilon(1e-12));
+  }
+  const VModel T = slice::untrim(U);
+  REQUIRE(T.cells.size() == 3);
+  const auto n = vmodel::counts(vmodel::build_topology(T));
+  CHECK(n.v_cells == 3);
+  CHECK(n.v_surfaces == 16);
+  CHECK(n.half_v_surfaces == 18);
+  CHECK(n.v_curves == 28);
+  CHECK(n.v_points == 16);
+  for (const auto& c : T.cells) CHECK(geom::volume(c.volume) == Approx(1.0).epsilon(1e-9));
+  // Membership is unchanged.
+  const auto inA = [&](const slice::Vec3& p) { return in_box(p, a0, a1); };
+  const auto inB = [&](const slice::Vec3& p) { return in_box(p, b0, b1); };
+  check_membership(T, {-0.5, -0.5, -0.5}, {2.5, 1.5, 2.5}, [&](auto& p) { return inA(p) || inB(p); },
+                   [&](const slice::Vec3& p) { return std::min(box_margin(p, a0, a1), box_margin(p, b0, b1)); },
+                   [&](auto& p) { return inA(p) && inB(p) ? "O1&O2" : inA(p) ? "O1" : "O2"; });
+}
+
+TEST_CASE("the volume of a curved trimmed cell is close to the analytic one", "[boolean]") {
+  // The ring 1 <= r <= 2, 0 <= z <= 1 minus the half-space slab x >= 1.2, 0.5 <= z: removed
+  // (segment of the r = 2 disk beyond x = 1.2) x 0.5 = (4 acos(0.6) - 1.2 * 1.6) * 0.5.
+  std::vector<double> rect;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) rect.insert(rect.end(), {1.0 + i, 0.0, double(j), 0.1});
+  const spline::Surface profile({KnotVector::bezier(2), KnotVector::bezier(2)}, 4, rect);
+  construct::Revolution rev;
+  rev.relative_tolerance = 1e-8;
+  VModel ring;
+  ring.properties = {"r"};
+  ring.cells.push_back({"ring", construct::revolve(profile, rev)});
+  const VModel X = vmodel::boolean(ring, box("b2", {1.2, -3, 0.5}, {3, 3, 2}, 0.3), BooleanOp::subtraction);
+  const slice::Locator loc(X, {.tolerance = 1e-9});
+  const double exact = 3 * M_PI - (4 * std::acos(0.6) - 1.2 * 1.6) * 0.5;
+  CHECK(slice::trimmed_volume(loc, 0) == Approx(exact).epsilon(5e-3));
+  // Not a parameter box: untrim leaves it alone.
+  CHECK(slice::untrim(X) == X);
 }
