@@ -2,6 +2,8 @@
 // revolution, sweep) on given curves or surfaces, regular or kernel-based (seed 004, Alg. 1),
 // with its Jacobian validity. Exit 1 when the result is not a valid parametrisation (then -o
 // writes nothing unless --keep-invalid).
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -10,6 +12,7 @@
 #include "trivox/construct/constructors.hpp"
 #include "trivox/construct/kernel_construct.hpp"
 #include "trivox/error.hpp"
+#include "trivox/geom/planar_crossing.hpp"
 #include "trivox/geom/validity.hpp"
 #include "trivox/io/construct_file.hpp"
 #include "trivox/io/model_file.hpp"
@@ -61,6 +64,31 @@ Verdict verdict_of(const spline::Trivariate& t) {
   if (t.dim() < 3) return {};
   const auto r = geom::check_validity(t);
   return {true, r.verdict == geom::Validity::valid, r.min_bound, r.max_bound};
+}
+
+/// Planar boundary curves must meet only at their shared ends (seed 004 Sec. 4: input
+/// "intersection and self-intersection free"), checked to 1e-5 of their extent.
+void check_simple(const io::ConstructInput& in, const std::string& file) {
+  if (in.curves.empty() || in.op == "extrude" || in.op == "revolve" || in.op == "sweep") return;
+  for (const auto& c : in.curves)
+    if (!planar_curve(c)) return;
+  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (const auto& c : in.curves)
+    for (int i = 0; i < c.size(); ++i)
+      for (int d = 0; d < 2; ++d) {
+        lo[d] = std::min(lo[d], c.point(i)[static_cast<std::size_t>(d)]);
+        hi[d] = std::max(hi[d], c.point(i)[static_cast<std::size_t>(d)]);
+      }
+  const double extent = std::hypot(hi[0] - lo[0], hi[1] - lo[1]);
+  if (!(extent > 0)) return;
+  const auto x = geom::first_crossing(in.curves, 1e-5 * extent);
+  if (!x) return;
+  const std::string where = "near (" + fmt(x->point[0], 8) + ", " + fmt(x->point[1], 8) + ")";
+  if (x->curve_a == x->curve_b)
+    throw Error(file + ": /curves/" + std::to_string(x->curve_a) + ": the curve crosses itself " + where +
+                "; expected curves free of self-intersections");
+  throw Error(file + ": /curves/" + std::to_string(x->curve_a) + " and /curves/" + std::to_string(x->curve_b) +
+              " cross " + where + "; expected boundary curves that meet only at their shared ends");
 }
 
 template <int P>
@@ -231,6 +259,7 @@ void add_construct(CLI::App& app, Common& common) {
     if (!opt->output.empty() && !opt->force && std::filesystem::exists(opt->output))
       throw Error(opt->output + ": the output file exists; expected a new path (or --force to overwrite)");
     const io::ConstructInput in = io::read_construct_input(io::read_file(opt->input), opt->input);
+    check_simple(in, opt->input);
     if (!in.curves.empty()) run<2>(*opt, in, common);
     else run<3>(*opt, in, common);
   });

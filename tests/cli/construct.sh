@@ -52,6 +52,9 @@ json.dump({"trivox": 1, "op": "boolean_sum", "surfaces": [face(k, v) for k in ra
           open(d + "/box.json", "w"))
 json.dump({"trivox": 1, "op": "extrude", "curves": [line([0, 0], [3, 0])], "vector": [0, 2]},
           open(d + "/extrude.json", "w"))
+json.dump({"trivox": 1, "op": "boolean_sum",
+           "curves": [line([0, 0], [1, 0]), line([0, 1], [1, 1]), line([0, 0], [0, 1]), poly([[1, 0], [-0.5, 0.5], [1, 1]])]},
+          open(d + "/crossing.json", "w"))
 json.dump({"trivox": 1, "op": "pizza", "curves": []}, open(d + "/badop.json", "w"))
 json.dump({"trivox": 1, "op": "ruled", "curves": [line([0, 0], [1, 0])]}, open(d + "/fewer.json", "w"))
 json.dump({"trivox": 1, "op": "boolean_sum",
@@ -156,6 +159,7 @@ expect_fail '/op: unknown constructor "pizza"; expected one of boolean_sum' "$tr
 expect_fail '/curves: 1 curve for "ruled"; expected 2 curves' "$trivox" construct "$tmp/fewer.json"
 expect_fail 'bottom(1) and right(0) are 0.5 apart' "$trivox" construct "$tmp/gap.json"
 expect_fail '/curves/1/points/0: 3 coordinates; expected 2 (as in /curves/0)' "$trivox" construct "$tmp/dims.json"
+expect_fail '/curves/2 and /curves/3 cross near (0, 0.3333' "$trivox" construct "$tmp/crossing.json"
 expect_fail 'no such file' "$trivox" construct "$tmp/missing.json"
 echo '{"trivox": 1, "op": "ruled", "curves": [' > "$tmp/broken.json"
 expect_fail 'malformed JSON' "$trivox" construct "$tmp/broken.json"
