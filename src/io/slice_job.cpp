@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <optional>
 #include <system_error>
 
 #include "trivox/error.hpp"
@@ -53,8 +54,7 @@ bool is_manifest_name(const std::string& name) {
 /// Per-worker scratch, reused across layers so a job allocates once per thread.
 struct Scratch {
   slice::RowBand band;
-  std::vector<float> fractions;
-  std::vector<std::uint8_t> chosen;
+  std::optional<slice::LayerDitherer> dither;  ///< its error rows, allocated once per thread
   std::vector<std::uint8_t> rgba;
   std::array<double, 5> seconds{};  ///< per stage, see SliceJobSummary::stage_seconds
 };
@@ -234,8 +234,9 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     out.counts.assign(static_cast<std::size_t>(nmat), 0);
     Scratch& s = scratch.local();
     s.rgba.resize(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * 4);
-    std::array<std::int64_t, 256> histogram{};
-    slice::LayerDitherer dither(mode, nx, nmat, grid.pitch[0], grid.pitch[1]);
+    std::vector<std::int64_t> counts(static_cast<std::size_t>(nmat), 0);
+    if (!s.dither) s.dither.emplace(mode, nx, nmat, grid.pitch[0], grid.pitch[1]);
+    slice::LayerDitherer& dither = *s.dither;
     dither.begin_layer(k);
     auto t = Clock::now();
     for (int r0 = 0; r0 < ny; r0 += band_rows) {
@@ -243,28 +244,17 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       sampler.sample(k, r0, rows, s.band);
       lap(t, s.seconds[0]);
       out.failures += s.band.failures;
-      // Row by row, so the fractions and material indices stay in the L1/L2 cache.
+      // Row by row: map, dither and paint in one pass (LayerDitherer::dither_paint), so nothing
+      // but the pixels leaves the L1/L2 cache.
       const auto unx = static_cast<std::size_t>(nx);
-      s.fractions.resize(unx * static_cast<std::size_t>(nmat));
-      s.chosen.resize(unx);
       for (int r = 0; r < rows; ++r) {
         const std::int32_t* cell = s.band.cell.data() + static_cast<std::size_t>(r) * unx;
-        mapper.fractions(s.band.props.data() + static_cast<std::size_t>(r) * unx * static_cast<std::size_t>(nprops), cell,
-                         unx, s.fractions.data());
-        lap(t, s.seconds[1]);
-        dither.dither(r0 + r, 1, cell, s.fractions.data(), s.chosen.data());
-        lap(t, s.seconds[2]);
-        // Every pixel written (void: transparent 0 0 0 0), so the image needs no clearing.
-        std::uint8_t* px = s.rgba.data() + static_cast<std::size_t>(r0 + r) * unx * 4;
-        for (std::size_t v = 0; v < unx; ++v) {
-          const std::uint8_t m = s.chosen[v];
-          std::memcpy(px + 4 * v, &colour[m], 4);
-          ++histogram[m];
-        }
-        lap(t, s.seconds[3]);
+        dither.dither_paint(r0 + r, cell, s.band.props.data() + static_cast<std::size_t>(r) * unx * static_cast<std::size_t>(nprops),
+                            mapper, colour, s.rgba.data() + static_cast<std::size_t>(r0 + r) * unx * 4, counts.data());
       }
+      lap(t, s.seconds[2]);
     }
-    std::copy_n(histogram.begin(), nmat, out.counts.begin());
+    out.counts = counts;
     out.png = encode_png_rgba(s.rgba.data(), nx, ny, cfg.dpi_x, cfg.dpi_y);
     out.sha256 = sha256_hex(out.png);
     lap(t, s.seconds[4]);

@@ -67,25 +67,88 @@ inline void load_fractions(const float* p, V4* f) noexcept {
   if constexpr (r == 3) f[q] = V4{p[4 * q], p[4 * q + 1], p[4 * q + 2], 0.0f};
 }
 
-/// fs for palettes of up to 8 materials, NV = ceil(MC / 4) vectors per voxel. The choice is a
-/// serial dependency from voxel to voxel (through the in-row error), so the kernel keeps it
-/// short and branch-free: masked max, first lane equal to it, one-hot by comparison.
-template <int MC>
-void fs_kernel(const FsRow& a) {
-  constexpr int NV = (MC + 3) / 4, S = 4 * NV;
-  V4 lane[NV], carry[NV];
-  for (int i = 0; i < NV; ++i) {
-    lane[i] = V4{0.0f, 1.0f, 2.0f, 3.0f} + static_cast<float>(4 * i);
-    carry[i] = V4{};
+/// Where the fs kernel's fractions come from and where its choices go: the plain form reads
+/// fraction vectors and writes material indices.
+struct FractionsIO {
+  static constexpr bool counts = false;
+  const float* fractions;
+  std::uint8_t* out;
+  template <int MC>
+  void load(int x, V4* f) const noexcept {
+    load_fractions<MC>(fractions + static_cast<std::ptrdiff_t>(x) * MC, f);
   }
-  const V4 none = V4{} - 3.0e38f, far = V4{} + 1.0e9f, one = V4{} + 1.0f;
+  void put(int x, int best) const noexcept { out[x] = static_cast<std::uint8_t>(best); }
+  void put_void(int x) const noexcept { out[x] = void_material; }
+};
+
+/// The print job's form for colour-only models (MaterialMapper::colour_only, the five colour
+/// materials at indices 0..4): the fractions are computed from each voxel's r, g, b right here
+/// (cmykw_fractions, the mapper's own floats) and the choices are painted as RGBA pixels, so
+/// that mapping and painting run in the shadow of the kernel's dependency chain and no fraction
+/// or index buffer makes a round trip through memory.
+struct ColourIO {
+  static constexpr bool counts = true;
+  const float* props;
+  int np, ir, ig, ib;
+  const std::uint32_t* colours;  // 256 entries
+  std::uint8_t* rgba;
+  template <int MC>
+  void load(int x, V4* f) const noexcept {
+    static_assert(MC >= 5);
+    const float* p = props + static_cast<std::ptrdiff_t>(x) * np;
+    float c[5];
+    cmykw_fractions(p[ir], p[ig], p[ib], c);
+    f[0] = V4{c[0], c[1], c[2], c[3]};
+    f[1] = V4{c[4], 0.0f, 0.0f, 0.0f};
+  }
+  void put(int x, int best) const noexcept { std::memcpy(rgba + 4 * static_cast<std::ptrdiff_t>(x), &colours[best], 4); }
+  void put_void(int x) const noexcept { std::memset(rgba + 4 * static_cast<std::ptrdiff_t>(x), 0, 4); }
+};
+
+using I4 = std::int32_t __attribute__((vector_size(16)));
+/// Lane-wise m ? b : a, for a mask m of comparison results (all ones or all zeros per lane).
+inline V4 select(I4 m, V4 b, V4 a) noexcept {
+  I4 ib, ia;
+  std::memcpy(&ib, &b, sizeof ib);
+  std::memcpy(&ia, &a, sizeof ia);
+  const I4 r = (m & ib) | (~m & ia);
+  V4 out;
+  std::memcpy(&out, &r, sizeof out);
+  return out;
+}
+
+/// The four lanes' sign bits (lane 0 lowest): of a comparison mask, which lanes are set.
+inline unsigned sign_bits(I4 m) noexcept {
+#if defined(__SSE__)
+  return static_cast<unsigned>(__builtin_ia32_movmskps(reinterpret_cast<V4>(m)));
+#else
+  return static_cast<unsigned>((m[0] & 1) | (m[1] & 2) | (m[2] & 4) | (m[3] & 8));
+#endif
+}
+
+/// fs for palettes of up to 8 materials, NV = ceil(MC / 4) vectors per voxel. The choice is a
+/// serial dependency from voxel to voxel (through the in-row error), and the loop body is long
+/// enough that its instruction count matters as much, so the kernel keeps both short:
+/// - the carry to the next voxel, w0 (v - onehot(k)), is computed for both outcomes of every
+///   lane before the choice (w0 v and w0 (v - 1)), so that the choice only selects: the chain
+///   is select -> add -> max -> compare;
+/// - the choice is read from the comparison's sign bits (the lowest set bit is the lowest index
+///   among ties), and the weights come pre-broadcast, one vector per neighbour and mask.
+/// The floats are those of w0 (v - onehot(k)) computed after the choice, operation for operation
+/// (the generic kernel's, which the tests compare against).
+/// counts (IO::counts): per-lane counts of the choices, as exact floats (a row has far fewer
+/// than 2^24 voxels).
+template <int MC, class IO>
+[[gnu::always_inline]] inline void fs_kernel(const FsRow& a, const IO io, V4* counts) {
+  constexpr int NV = (MC + 3) / 4, S = 4 * NV;
+  const V4 none = V4{} - 3.0e38f, one = V4{} + 1.0f;
 
   // Locals, not a's fields: stores through the uint8_t output may alias anything, and the
   // compiler would reload every field after each.
   const std::int32_t* const cell = a.cell;
-  const float* const fractions = a.fractions;
-  std::uint8_t* const out = a.out;
-  const float(*const weights)[4] = a.weights;
+  V4 wv[8][4];
+  for (int m = 0; m < 8; ++m)
+    for (int k = 0; k < 4; ++k) wv[m][k] = V4{} + a.weights[m][k];
   const int nx = a.nx, dir = a.left_to_right ? 1 : -1;
   int x = a.left_to_right ? 0 : nx - 1;
   const float* in = a.in + S;  // skip the pad: in + x * S is voxel x
@@ -95,65 +158,69 @@ void fs_kernel(const FsRow& a) {
   // registers (here: down[x], fwd: down[x + dir]) and stored once, final, in the same order of
   // additions as accumulating in memory would use; every voxel and both pads get stored, so
   // `down` needs no clearing and `in` is only read.
-  V4 acc_here[NV], acc_fwd[NV];
-  for (int i = 0; i < NV; ++i) acc_here[i] = acc_fwd[i] = V4{};
+  V4 acc_here[NV], acc_fwd[NV], cnt[NV];
+  // The carry into the current voxel is hm ? cb : ca (lane-wise): w0 (v - 1) where the previous
+  // voxel chose that lane, w0 v elsewhere; both 0 at a row start or after a void voxel.
+  V4 ca[NV], cb[NV];
+  I4 hm[NV];
+  for (int i = 0; i < NV; ++i) acc_here[i] = acc_fwd[i] = cnt[i] = ca[i] = cb[i] = V4{}, hm[i] = I4{};
   for (int t = 0; t < nx; ++t, x += dir) {
     const float* e = in + static_cast<std::ptrdiff_t>(x) * S;
     float* d_back = down + static_cast<std::ptrdiff_t>(x - dir) * S;
     if (cell[x] < 0) {  // void: the error aimed here is dropped, none leaves
-      out[x] = void_material;
+      io.put_void(x);
       for (int i = 0; i < NV; ++i) {
         store(d_back + 4 * i, acc_here[i]);
         acc_here[i] = acc_fwd[i];
         acc_fwd[i] = V4{};
-        carry[i] = V4{};
+        ca[i] = cb[i] = V4{};
       }
       continue;
     }
     V4 f[NV];
-    load_fractions<MC>(fractions + static_cast<std::ptrdiff_t>(x) * MC, f);
+    io.template load<MC>(x, f);
     // Corrected fractions v = (f + e) + carry. The candidates are the materials this voxel
     // holds (error from a neighbouring region must not print a material absent here; it stays
-    // in the error): `masked` pushes the others to -3e38. Everything not involving carry is
-    // off the voxel-to-voxel dependency chain, which runs carry -> masked -> max -> one-hot ->
-    // error -> carry.
+    // in the error): `masked` pushes the others to -3e38.
     V4 v[NV], masked[NV];
     for (int i = 0; i < NV; ++i) {
       const V4 base = f[i] + load(e + 4 * i);
       const V4 penalised = base + (f[i] > 0.0f ? V4{} : none);
-      v[i] = base + carry[i];
-      masked[i] = penalised + carry[i];
+      const V4 carry = select(hm[i], cb[i], ca[i]);
+      v[i] = base + carry;
+      masked[i] = penalised + carry;
     }
     V4 mv = masked[0];
     for (int i = 1; i < NV; ++i) mv = mv > masked[i] ? mv : masked[i];
-    const float top = std::max(std::max(mv[0], mv[1]), std::max(mv[2], mv[3]));
-    V4 hit[NV], hits = V4{}, index = V4{};
+    // Horizontal max, broadcast to every lane.
+    mv = mv > __builtin_shufflevector(mv, mv, 2, 3, 0, 1) ? mv : __builtin_shufflevector(mv, mv, 2, 3, 0, 1);
+    mv = mv > __builtin_shufflevector(mv, mv, 1, 0, 3, 2) ? mv : __builtin_shufflevector(mv, mv, 1, 0, 3, 2);
+    unsigned bits = 0;
     for (int i = 0; i < NV; ++i) {
-      hit[i] = masked[i] == top ? one : V4{};
-      hits += hit[i];
-      index += hit[i] * lane[i];
+      hm[i] = masked[i] == mv;
+      bits |= sign_bits(hm[i]) << (4 * i);
     }
-    float best = index[0] + index[1] + index[2] + index[3];
-    if (hits[0] + hits[1] + hits[2] + hits[3] != 1.0f) [[unlikely]] {
-      // A tie (exact equality of corrected fractions): the lowest index wins.
-      V4 first = far;
+    // The lowest set bit: the lowest index among ties (exact equality of corrected fractions),
+    // which then is the only one chosen.
+    const int best = __builtin_ctz(bits);
+    if (bits & (bits - 1)) [[unlikely]]
       for (int i = 0; i < NV; ++i) {
-        const V4 c = hit[i] > 0.0f ? lane[i] : far;
-        first = first < c ? first : c;
+        const I4 lanes = I4{0, 1, 2, 3} + 4 * i;
+        hm[i] = lanes == best;
       }
-      best = std::min(std::min(first[0], first[1]), std::min(first[2], first[3]));
-      for (int i = 0; i < NV; ++i) hit[i] = lane[i] == best ? one : V4{};
-    }
-    out[x] = static_cast<std::uint8_t>(best);
+    io.put(x, best);
 
     const bool last = t + 1 == nx;
     const int mask = (!last && cell[x + dir] >= 0 ? has_forward : 0) | (t > 0 ? has_down_back : 0) |
                      (!last ? has_down_forward : 0);
-    const float* w = weights[mask];
+    const V4* w = wv[mask];
     // Unavailable neighbours have weight 0, and the pads absorb the edge writes.
     for (int i = 0; i < NV; ++i) {
-      const V4 err = v[i] - hit[i];
-      carry[i] = w[0] * err;
+      const V4 hit = select(hm[i], one, V4{});
+      if constexpr (IO::counts) cnt[i] += hit;
+      const V4 err = v[i] - hit;
+      ca[i] = w[0] * v[i];
+      cb[i] = w[0] * (v[i] - one);
       store(d_back + 4 * i, acc_here[i] + w[1] * err);
       acc_here[i] = acc_fwd[i] + w[2] * err;
       acc_fwd[i] = w[3] * err;
@@ -164,6 +231,50 @@ void fs_kernel(const FsRow& a) {
     store(down + static_cast<std::ptrdiff_t>(x - dir) * S + 4 * i, acc_here[i]);
     store(down + static_cast<std::ptrdiff_t>(x) * S + 4 * i, acc_fwd[i]);
   }
+  if constexpr (IO::counts)
+    for (int i = 0; i < NV; ++i) counts[i] += cnt[i];
+}
+
+/// The fused kernels, compiled twice on x86-64: for the baseline and, picked at run time where
+/// the CPU has it, for AVX2 (VEX encoding: three-operand instructions, fewer register copies in
+/// a loop that is as much throughput- as latency-bound). Both run the same IEEE operations in
+/// the same order (no contraction: the project compiles with -ffp-contract=off), so their
+/// output is bit-identical; the tests run whichever the machine picks against the step-by-step
+/// path.
+using ColourKernel = void (*)(const FsRow&, const ColourIO&, V4*);
+template <int MC>
+void colour_kernel(const FsRow& a, const ColourIO& io, V4* counts) {
+  fs_kernel<MC>(a, io, counts);
+}
+#if defined(__x86_64__) && defined(__GNUC__)
+#define TRIVOX_DITHER_AVX2 1
+template <int MC>
+[[gnu::target("avx2")]] void colour_kernel_avx2(const FsRow& a, const ColourIO& io, V4* counts) {
+  fs_kernel<MC>(a, io, counts);
+}
+#endif
+
+ColourKernel colour_kernel_for(int materials) {
+#ifdef TRIVOX_DITHER_AVX2
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) switch (materials) {
+      case 5: return colour_kernel_avx2<5>;
+      case 6: return colour_kernel_avx2<6>;
+      case 7: return colour_kernel_avx2<7>;
+      default: return colour_kernel_avx2<8>;
+    }
+#endif
+  switch (materials) {
+    case 5: return colour_kernel<5>;
+    case 6: return colour_kernel<6>;
+    case 7: return colour_kernel<7>;
+    default: return colour_kernel<8>;
+  }
+}
+
+template <int MC>
+void fs_kernel(const FsRow& a) {
+  fs_kernel<MC>(a, FractionsIO{a.fractions, a.out}, nullptr);
 }
 
 /// fs for any number of materials (more than 8): the same choice and diffusion, one float at
@@ -381,6 +492,48 @@ void LayerDitherer::fs_row(int row, const std::int32_t* cell, const float* fract
   // was the row below. Keep them exactly zero.
   std::fill(in, in + stride, 0.0f);
   std::fill(in + half - static_cast<std::size_t>(stride), in + half, 0.0f);
+}
+
+void LayerDitherer::dither_paint(int row, const std::int32_t* cell, const float* props, const MaterialMapper& mapper,
+                                 const std::array<std::uint32_t, 256>& colours, std::uint8_t* rgba, std::int64_t* counts) {
+  if (mapper.materials() != materials_)
+    throw Error("dithering: a mapper of " + std::to_string(mapper.materials()) + " materials for a ditherer of " +
+                    std::to_string(materials_) + "; expected the same palette",
+                ErrorKind::failed);
+  const auto nx = static_cast<std::size_t>(nx_);
+  const auto cm = mapper.colour_materials();
+  const bool fused = mode_ == DitherMode::fs && mapper.colour_only() && materials_ >= 5 && materials_ <= 8 &&
+                     cm == std::array<int, 5>{0, 1, 2, 3, 4};
+  if (!fused) {
+    row_fractions_.resize(nx * static_cast<std::size_t>(materials_));
+    row_chosen_.resize(nx);
+    mapper.fractions(props, cell, nx, row_fractions_.data());
+    dither(row, 1, cell, row_fractions_.data(), row_chosen_.data());
+    for (std::size_t v = 0; v < nx; ++v) {
+      const std::uint8_t m = row_chosen_[v];
+      std::memcpy(rgba + 4 * v, &colours[m], 4);
+      if (m != void_material) ++counts[m];
+    }
+    return;
+  }
+  if (row < 0 || row < next_row_)
+    throw Error("dithering layer " + std::to_string(layer_) + ": row " + std::to_string(row) + " after rows up to " +
+                    std::to_string(next_row_ - 1) + "; expected increasing rows (error diffusion runs downwards)",
+                ErrorKind::failed);
+  if (row > next_row_) std::fill(error_.begin(), error_.end(), 0.0f);
+  next_row_ = row + 1;
+  const std::size_t half = error_.size() / 2;
+  float* in = error_.data() + (row % 2 == 0 ? 0 : half);
+  float* down = error_.data() + (row % 2 == 0 ? half : 0);
+  const int stride = error_stride(materials_);
+  const FsRow a{nx_, materials_, stride, row % 2 == 0, weights_, cell, nullptr, nullptr, in, down, scratch_.data()};
+  const auto cp = mapper.colour_properties();
+  const ColourIO io{props, mapper.properties(), cp[0], cp[1], cp[2], colours.data(), rgba};
+  V4 c[2] = {V4{}, V4{}};
+  colour_kernel_for(materials_)(a, io, c);
+  std::fill(in, in + stride, 0.0f);  // as fs_row
+  std::fill(in + half - static_cast<std::size_t>(stride), in + half, 0.0f);
+  for (int m = 0; m < materials_; ++m) counts[m] += static_cast<std::int64_t>(c[m / 4][m % 4]);
 }
 
 void LayerDitherer::stochastic_row(int row, const std::int32_t* cell, const float* fractions,

@@ -130,20 +130,8 @@ int material_named(const Source& src, const Palette& p, const json& j, const std
   return i;
 }
 
-/// The r, g, b conversion's C, M, Y, K, W with m = max(r, g, b) (the derivation is in
-/// docs/materials.md); the clamp also turns NaN into 0.
-[[gnu::always_inline]] inline void cmykw(float r, float g, float b, float* f) noexcept {
-  r = r > 0.0f ? (r < 1.0f ? r : 1.0f) : 0.0f;
-  g = g > 0.0f ? (g < 1.0f ? g : 1.0f) : 0.0f;
-  b = b > 0.0f ? (b < 1.0f ? b : 1.0f) : 0.0f;
-  const float m = std::max(r, std::max(g, b));
-  const float w = r + g + b - 2.0f * m;
-  // W < 0: out of reach of side-by-side mixing; drop white and keep the proportions of the
-  // rest, whose sum is 1 - W. Branch-free (s = 1 exactly when W >= 0), since a colour field
-  // near the edge of the reachable colours would make a branch unpredictable.
-  const float s = 1.0f / (1.0f - std::min(w, 0.0f));
-  f[0] = (m - r) * s, f[1] = (m - g) * s, f[2] = (m - b) * s, f[3] = (1.0f - m) * s, f[4] = std::max(w, 0.0f);
-}
+/// The r, g, b conversion (docs/materials.md), shared with the fused kernels.
+[[gnu::always_inline]] inline void cmykw(float r, float g, float b, float* f) noexcept { cmykw_fractions(r, g, b, f); }
 
 /// An explicit fraction: negative and NaN become 0, and huge values stay finite when summed.
 inline float clamp_fraction(float v) noexcept { return v > 0.0f ? (v < 1e30f ? v : 1e30f) : 0.0f; }

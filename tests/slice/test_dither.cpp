@@ -3,7 +3,9 @@
 // Set TRIVOX_PRINT_SHARES=1 to print the measured shares.
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdlib>
 #include <iostream>
 #include <random>
@@ -324,4 +326,68 @@ TEST_CASE("stochastic: deterministic per (seed, layer, row, column), in any row 
     d.dither(y, 1, layer.cell.data() + layer.at(0, y), layer.fractions.data() + layer.at(0, y) * layer.m,
              b.data() + layer.at(0, y));
   CHECK(a == b);
+}
+
+TEST_CASE("dither_paint: one pass of map, dither and paint equals the three steps in turn", "[dither]") {
+  // Colour fields (some out of the reachable colours, some NaN, clamped) with void holes and a
+  // void row; the default palette runs the fused kernel, a palette with the colour materials
+  // elsewhere (and an extra material) the step-by-step path; 5, 7 and 8 materials too.
+  const int nx = 173, ny = 41, np = 4;  // properties: density, r, g, b
+  std::vector<std::int32_t> cell(static_cast<std::size_t>(nx) * ny, 0);
+  std::vector<float> props(cell.size() * np);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-0.1f, 1.1f);
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x) {
+      const std::size_t v = static_cast<std::size_t>(y) * nx + x;
+      const float s = 0.5f + 0.5f * std::sin(0.05f * x + 0.1f * y);
+      props[v * np] = u(rng);
+      props[v * np + 1] = (x % 5 == 0) ? u(rng) : s;
+      props[v * np + 2] = (x % 17 == 0) ? std::nanf("") : 1.0f - s;
+      props[v * np + 3] = (y % 3 == 0) ? u(rng) : 0.5f * s;
+      if ((x * 7 + y * 3) % 19 == 0 || y == 20 || (x > 60 && x < 70)) cell[v] = -1;
+    }
+  Palette moved = default_palette();
+  std::swap(moved.materials[0], moved.materials[5]);
+  moved.materials.push_back({"Extra", {1, 2, 3, 255}});
+  std::vector<Palette> palettes = {default_palette(), moved};
+  for (int m : {5, 7, 8}) {
+    Palette p = default_palette();
+    p.materials.resize(5);
+    for (int k = 5; k < m; ++k) p.materials.push_back({"Extra" + std::to_string(k), {std::uint8_t(k), 2, 3, 255}});
+    palettes.push_back(p);
+  }
+  const std::vector<std::string> names = {"density", "r", "g", "b"};
+  for (const Palette& palette : palettes)
+    for (DitherMode mode : {DitherMode::fs, DitherMode::stochastic, DitherMode::none}) {
+      const MaterialMapper mapper(palette, names);
+      const int nm = mapper.materials();
+      std::array<std::uint32_t, 256> colours{};
+      for (int k = 0; k < nm; ++k) std::memcpy(&colours[static_cast<std::size_t>(k)], palette.materials[static_cast<std::size_t>(k)].rgba.data(), 4);
+      // The three steps.
+      std::vector<float> fr(cell.size() * static_cast<std::size_t>(nm), 0.0f);
+      mapper.fractions(props.data(), cell.data(), cell.size(), fr.data());
+      LayerDitherer d1(mode, nx, nm, 0.0423, 0.0847);
+      d1.begin_layer(3);
+      std::vector<std::uint8_t> chosen(cell.size());
+      d1.dither(0, ny, cell.data(), fr.data(), chosen.data());
+      std::vector<std::uint8_t> want(cell.size() * 4);
+      std::vector<std::int64_t> want_counts(static_cast<std::size_t>(nm), 0);
+      for (std::size_t v = 0; v < cell.size(); ++v) {
+        std::memcpy(want.data() + 4 * v, &colours[chosen[v]], 4);
+        if (chosen[v] != void_material) ++want_counts[chosen[v]];
+      }
+      // One pass, row by row.
+      LayerDitherer d2(mode, nx, nm, 0.0423, 0.0847);
+      d2.begin_layer(3);
+      std::vector<std::uint8_t> got(cell.size() * 4, 9);
+      std::vector<std::int64_t> counts(static_cast<std::size_t>(nm), 0);
+      for (int y = 0; y < ny; ++y) {
+        const std::size_t at = static_cast<std::size_t>(y) * nx;
+        d2.dither_paint(y, cell.data() + at, props.data() + at * np, mapper, colours, got.data() + 4 * at, counts.data());
+      }
+      INFO(nm << " materials, mode " << dither_mode_name(mode) << ", first material " << palette.materials[0].name);
+      CHECK(got == want);
+      CHECK(counts == want_counts);
+    }
 }

@@ -9,12 +9,17 @@
 // 3. Peak memory of a full-tray-width J750 layer (11,575 x 4,606 px): the model scaled to the
 //    tray (490 x 390 mm) and to `tray_layers` layers; ru_maxrss after the job (run first).
 //
-// Usage: trivox_bench_slice [MODEL [LAYERS_FOR_STEP_1 [TRAY_LAYERS]]]
+// Usage: trivox_bench_slice [MODEL [LAYERS_FOR_STEP_1 [TRAY_LAYERS [THREADS]]]]
 //   LAYERS_FOR_STEP_1: scale the model's height to this many J750 layers (0: keep its height).
+//   TRAY_LAYERS: 0 skips step 3. THREADS (default 2): for step 1 and its floor.
+// With TRIVOX_BENCH_JOB_ONLY=1 only the job of step 1 runs (for callgrind: repeatable
+// instruction counts of the job alone).
 #include <sys/resource.h>
+#include <unistd.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -66,12 +71,15 @@ int main(int argc, char** argv) {
   const fs::path model_path = argc > 1 ? argv[1] : "models/twisted_column.json";
   const int layers = argc > 2 ? std::atoi(argv[2]) : 0;
   const int tray_layers = argc > 3 ? std::atoi(argv[3]) : 2;
-  const fs::path tmp = fs::temp_directory_path() / "trivox-bench-slice";
+  const int threads = argc > 4 ? std::max(1, std::atoi(argv[4])) : 2;
+  const char* job_only_env = std::getenv("TRIVOX_BENCH_JOB_ONLY");
+  const bool job_only = job_only_env && std::string(job_only_env) == "1";
+  const fs::path tmp = fs::temp_directory_path() / ("trivox-bench-slice-" + std::to_string(getpid()));
   vmodel::VModel model = io::load_model(model_path);
   if (layers > 0) model = scaled(model, {0, 0, layers * 0.027});
 
   // 3 (run first, so the peak is this job's). Peak memory for full-tray-width layers.
-  {
+  if (tray_layers > 0 && !job_only) {
     const auto tray = scaled(model, {490.0 - 1e-6, 390.0 - 1e-6, tray_layers * 0.027});
     const auto s = run(tray, tmp / "tray", 2);
     rusage ru{};
@@ -84,7 +92,16 @@ int main(int argc, char** argv) {
     std::printf("peak memory of the tray job (ru_maxrss): %.1f MB\n", ru.ru_maxrss / 1024.0);
   }
   // 1. The job against the floor.
-  const auto job = run(model, tmp / "job", 2);
+  const auto job = run(model, tmp / "job", threads);
+  if (job_only) {
+    std::printf("job: %d x %d x %d, %.3f s, stages (ns per voxel):", job.grid.count[0], job.grid.count[1], job.grid.count[2],
+                job.seconds);
+    for (std::size_t i = 0; i < job.stage_seconds.size(); ++i)
+      std::printf(" %s %.1f", io::slice_stage_names[i], 1e9 * job.stage_seconds[i] / static_cast<double>(job.voxels));
+    std::printf("\n");
+    fs::remove_all(tmp);
+    return 0;
+  }
   std::vector<std::string> names;
   std::vector<io::RgbaImage> images;
   const auto cfg = io::read_stack_config(tmp / "job");
@@ -95,7 +112,7 @@ int main(int argc, char** argv) {
   fs::create_directories(tmp / "floor");
   double floor_s;
   {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     const auto t0 = Clock::now();
     tbb::parallel_for(std::size_t{0}, images.size(), [&](std::size_t i) {
       const auto& im = images[i];
@@ -106,7 +123,7 @@ int main(int argc, char** argv) {
     io::sync_folder_contents(tmp / "floor");  // as the job does before its ConfigFile.xml
     floor_s = since(t0);
   }
-  std::printf("trivox bench_slice: %s, J750 600 x 300 dpi, 27 um layers, 2 threads\n", model_path.c_str());
+  std::printf("trivox bench_slice: %s, J750 600 x 300 dpi, 27 um layers, %d threads\n", model_path.c_str(), threads);
   std::printf("%-44s %12s %14s %8s\n", "step", "seconds", "voxels/s", "ratio");
   std::printf("%-44s %12.3f %14.4g %8s\n",
               ("job: " + std::to_string(job.grid.count[0]) + " x " + std::to_string(job.grid.count[1]) + " x " +

@@ -4,7 +4,8 @@
 ///
 /// A TBB pipeline with a bounded number of layers in flight: layers are sampled in parallel band
 /// by band (slice::LayerSampler), mapped to material fractions (slice::MaterialMapper), dithered
-/// (slice::LayerDitherer), painted in palette colours and encoded to PNG in memory; an in-order
+/// (slice::LayerDitherer) and painted in palette colours, the three in one pass per row
+/// (LayerDitherer::dither_paint), and encoded to PNG in memory; an in-order
 /// stage writes each slice to a temporary name and renames it. ConfigFile.xml is written last,
 /// after a sync, so an interrupted job never looks complete. The manifest (manifest.hpp) is
 /// rewritten every few seconds after a sync; it lets a killed job resume (`resume`: listed layers
@@ -68,7 +69,9 @@ struct SliceJobSummary {
   std::string mapping;                   ///< how properties drive materials
   std::filesystem::path zip_file;        ///< set when zip was asked for
   /// Thread-seconds spent per stage, summed over workers: sample (locate + evaluate), map
-  /// (properties to fractions), dither, paint (material indices to RGBA and counts), encode (PNG).
+  /// (properties to fractions), dither, paint (material indices to RGBA and counts), encode (PNG
+  /// and its SHA-256). Map, dither and paint run as one pass per row
+  /// (slice::LayerDitherer::dither_paint), timed together under dither; map and paint stay 0.
   /// Writing is the remainder. For benchmarks and `--json`; not part of any output file.
   std::array<double, 5> stage_seconds{};
   int layers_kept = 0;                   ///< layers a resumed job found done and verified

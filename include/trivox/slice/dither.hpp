@@ -23,15 +23,18 @@
 /// split into bands. Rows skipped between two calls count as void rows.
 ///
 /// Cost: O(materials) per non-void voxel (about 8 flops per material for `fs`, in 4-wide vectors
-/// up to 8 materials), O(1) per void voxel; no allocation after construction; memory for `fs`
+/// up to 8 materials; dither_paint maps, dithers and paints in one pass), O(1) per void voxel; no allocation after construction; memory for `fs`
 /// 2 (nx + 2) s floats, s = materials (rounded up to a multiple of 4 when at most 8). One LayerDitherer per thread: it holds the
 /// error state of the layer in progress.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <string_view>
 #include <vector>
 
 namespace trivox::slice {
+
+class MaterialMapper;
 
 enum class DitherMode { fs, stochastic, none };
 
@@ -81,6 +84,23 @@ public:
   /// @throws trivox::Error (failed) when fs rows go backwards (row0 below the previous end)
   void dither(int row0, int rows, const std::int32_t* cell, const float* fractions, std::uint8_t* out);
 
+  /// The print job's row: maps the voxels' properties to fractions (`mapper`), dithers them as
+  /// dither() does and paints each voxel in its material's colour, with exactly the output of
+  /// those three steps one after the other (mapper.fractions, dither, colours[index]). For fs
+  /// with a colour-only mapper whose colour materials are indices 0..4 of at most 8, the three
+  /// run in one pass (the mapping and painting hide behind the dither's dependency chain, and
+  /// no fraction or index buffer makes a round trip through memory); otherwise in turn, through
+  /// buffers held here.
+  /// @param row      the row (same rules as dither())
+  /// @param cell     nx values; < 0 marks a void voxel
+  /// @param props    nx * mapper.properties() floats, voxel-major (RowBand::props)
+  /// @param mapper   the job's mapper; mapper.materials() == materials()
+  /// @param colours  RGBA of each material index, 4 bytes each (index 255: void, 0 0 0 0)
+  /// @param rgba     nx * 4 bytes written
+  /// @param counts   materials() counters: each gets the number of voxels of that material added
+  void dither_paint(int row, const std::int32_t* cell, const float* props, const MaterialMapper& mapper,
+                    const std::array<std::uint32_t, 256>& colours, std::uint8_t* rgba, std::int64_t* counts);
+
   DitherMode mode() const noexcept { return mode_; }
   int nx() const noexcept { return nx_; }
   int materials() const noexcept { return materials_; }
@@ -98,6 +118,8 @@ private:
   float weights_[8][4] = {};    // per neighbour-availability mask: forward, down_back, down, down_forward
   std::vector<float> error_;    // 2 halves of (nx + 2) * stride: incoming error of a row, and of the next
   std::vector<float> scratch_;  // corrected fractions and the in-row carry (runtime-count kernel)
+  std::vector<float> row_fractions_;       // dither_paint's buffers when it runs step by step
+  std::vector<std::uint8_t> row_chosen_;
 };
 
 }  // namespace trivox::slice

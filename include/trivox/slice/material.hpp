@@ -18,6 +18,7 @@
 /// Cost: parsing a palette is linear in the file; MaterialMapper::fractions is O(properties +
 /// materials) per voxel with no allocation.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -107,6 +108,13 @@ public:
   int properties() const noexcept { return properties_; }
   /// True when no property drives a material: every voxel gets the default material.
   bool constant() const noexcept { return explicit_.empty() && !rgb_; }
+  /// True when only the colour r, g, b drives the materials (no property names a material):
+  /// then a voxel's fractions are cmykw_fractions of its colour, placed at colour_materials().
+  bool colour_only() const noexcept { return rgb_ && explicit_.empty(); }
+  /// Indices of r, g and b among the properties (meaningful when colour_only()).
+  std::array<int, 3> colour_properties() const noexcept { return rgb_props_; }
+  /// Material indices of cyan, magenta, yellow, black and white (meaningful when colour_only()).
+  std::array<int, 5> colour_materials() const noexcept { return cmykw_; }
 
   /// Fractions of one voxel.
   /// @param props  properties() values, in the model's property order (NaN counts as 0)
@@ -149,5 +157,21 @@ private:
 /// and (1,1,1) with these weights gives back (r, g, b).
 /// @return {C, M, Y, K, W}, each in [0, 1], summing to 1
 std::array<float, 5> rgb_to_cmykw(float r, float g, float b) noexcept;
+
+/// rgb_to_cmykw into f[0..4], inline for kernels that map and dither in one pass (LayerDitherer::
+/// dither_paint): every caller gets the same floats, operation for operation.
+[[gnu::always_inline]] inline void cmykw_fractions(float r, float g, float b, float* f) noexcept {
+  // The clamp also turns NaN into 0.
+  r = r > 0.0f ? (r < 1.0f ? r : 1.0f) : 0.0f;
+  g = g > 0.0f ? (g < 1.0f ? g : 1.0f) : 0.0f;
+  b = b > 0.0f ? (b < 1.0f ? b : 1.0f) : 0.0f;
+  const float m = std::max(r, std::max(g, b));
+  const float w = r + g + b - 2.0f * m;
+  // W < 0: out of reach of side-by-side mixing; drop white and keep the proportions of the
+  // rest, whose sum is 1 - W. Branch-free (s = 1 exactly when W >= 0), since a colour field
+  // near the edge of the reachable colours would make a branch unpredictable.
+  const float s = 1.0f / (1.0f - std::min(w, 0.0f));
+  f[0] = (m - r) * s, f[1] = (m - g) * s, f[2] = (m - b) * s, f[3] = (1.0f - m) * s, f[4] = std::max(w, 0.0f);
+}
 
 }  // namespace trivox::slice
