@@ -188,6 +188,24 @@ TEST_CASE("kernel-based half Boolean sum of two curves (seed 004 Lemma 1 boundar
   CHECK(boundary_gap(r.spline, 0, 0.0, c[1]) < 1e-12);
 }
 
+TEST_CASE("kernel-based ruling starts from a ruling at order 3 (seed 004 Sec. 5.1)", "[kernel]") {
+  const std::vector<Curve> c{cubic({{-1, -1}, {-0.12, -1.01}, {-0.82, -1.11}, {1, -1}}),
+                             cubic({{-1, 1}, {0.61, 0.53}, {-1.44, 1.49}, {1, 1}})};
+  const Surface s0 = construct::regular_construct(KernelOp::ruled, c);
+  CHECK(s0.orders() == std::array<int, 2>{4, 3});
+  // Still the linear ruling (1 - v) bottom + v top, which folds here.
+  for (double u : {0.1, 0.5, 0.9}) {
+    const auto p = s0.eval({u, 0.3}), b = c[0].eval({u}), t = c[1].eval({u});
+    for (int h = 0; h < 3; ++h) CHECK(p[static_cast<std::size_t>(h)] == Approx(0.7 * b[static_cast<std::size_t>(h)] + 0.3 * t[static_cast<std::size_t>(h)]));
+  }
+  REQUIRE(det_range(s0)[0] < 0.0);
+  const auto r = construct::kernel_construct(KernelOp::ruled, c);
+  REQUIRE(r.valid);
+  CHECK(det_range(r.spline)[0] >= 0.0);
+  CHECK(boundary_gap(r.spline, 1, 0.0, c[0]) < 1e-12);
+  CHECK(boundary_gap(r.spline, 1, 1.0, c[1]) < 1e-12);
+}
+
 TEST_CASE("a valid regular construction is returned as it is; a boundary without kernel fails", "[kernel]") {
   const std::vector<Curve> square{cubic({{0, 0}, {1, 0}, {2, 0}, {3, 0}}), cubic({{0, 3}, {1, 3}, {2, 3}, {3, 3}}),
                                   cubic({{0, 0}, {0, 1}, {0, 2}, {0, 3}}), cubic({{3, 0}, {3, 1}, {3, 2}, {3, 3}})};
