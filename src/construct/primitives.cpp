@@ -739,7 +739,13 @@ FieldReport apply_field(std::vector<PrimitiveCell>& cells, const Field& f, const
     report.max_error = err;
     report.refinements = round;
     report.converged = err <= options.relative_tolerance;
-    if (report.converged || round >= options.max_refinements) {
+    long next = 0;
+    for (const auto& g : geometry) {
+      long n = 1;
+      for (int d = 0; d < 3; ++d) n *= g.count(d) + static_cast<long>(g.knots(d).breakpoints().size()) - 1;
+      next += n;
+    }
+    if (report.converged || round >= options.max_refinements || next > options.max_control_points) {
       for (std::size_t i = 0; i < cells.size(); ++i) cells[i].volume = std::move(result[i]);
       return report;
     }

@@ -168,7 +168,10 @@ struct FieldOptions {
   /// |v1 - v0|), that refinement aims for: 1/512, a quarter of an 8-bit grey level.
   double relative_tolerance = 1.0 / 512.0;
   /// Uniform refinements (every knot span halved in every direction) tried at most.
-  int max_refinements = 3;
+  int max_refinements = 2;
+  /// No refinement that would give the cells more control points than this in total (each
+  /// multiplies them by about 8; the slicer and validity checks pay for every one).
+  long max_control_points = 60000;
 };
 
 /// How well the properties follow the exact field.
@@ -190,7 +193,8 @@ struct FieldReport {
 /// clamped inside the cells) are interpolated at the Greville abscissae of each cell: the order
 /// of every direction is first raised to at least 4, then all cells are refined uniformly (the
 /// same knots on both sides of every shared face, so the field stays continuous) until the
-/// sampled error is below options.relative_tolerance or max_refinements is reached. Near a kink
+/// sampled error is below options.relative_tolerance or max_refinements (or the control-point
+/// budget) is reached. Near a kink
 /// of the exact field (the centre of a radial field, a clamping plane or sphere inside a cell)
 /// a polynomial cannot follow it: the error there is about the slope times a knot span, and is
 /// what max_error reports.

@@ -1,0 +1,99 @@
+/// @file trivox/io/scene.hpp
+/// @brief Scenes: model files whose cells may be primitives with property fields, and which may
+/// list operations; `trivox build` turns one into a model (DESIGN.md, "Model file";
+/// docs/model-format.md, "Scenes", is the user's reference).
+///
+/// A scene has the model file's header (`trivox`, `units`, `properties`) and `cells`, each
+/// either `{"name", "trivariate": SPLINE}` as in a model or `{"name", "primitive": {...},
+/// "field": {...}}` (construct/primitives.hpp: seed 003 Sec. 3.2.3), optional free `surfaces`,
+/// and `operations`, a list of `{"op": NAME, ...}`. Reading checks every value before use and
+/// reports the first problem as trivox::Error (bad_input) "<file>: <JSON pointer>: <found>;
+/// expected <what>", reusing the model reader's checked access (src/io/json_io.hpp).
+///
+/// Operations: the names of DESIGN.md (`union`, `intersection`, `subtraction`, `fillet` and the
+/// constructors `ruled`, `extrude`, `revolve`, `boolean_sum`, `half_boolean_sum`, `sweep`) are
+/// recognised; building them is later work, so build_scene refuses a scene with any operation,
+/// naming it ("not supported yet"). An unknown name is refused by the reader, which lists the
+/// known ones.
+///
+/// Cost: linear in the file size to read; building is the primitives' cost (milliseconds each)
+/// plus any field refinement.
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "trivox/construct/primitives.hpp"
+#include "trivox/vmodel/vmodel.hpp"
+
+namespace trivox::io {
+
+/// The operation names a scene may use (DESIGN.md), in the order messages list them.
+inline constexpr const char* scene_operations[] = {"union",   "intersection", "subtraction", "fillet",
+                                                   "ruled",   "extrude",      "revolve",     "boolean_sum",
+                                                   "half_boolean_sum", "sweep"};
+
+/// A primitive cell's recipe.
+struct ScenePrimitive {
+  construct::Primitive primitive;
+  construct::PrimitiveOptions options;     ///< the optional "tolerance" of the primitive object
+  std::optional<construct::Field> field;   ///< absent only when the scene has no properties
+};
+
+struct SceneCell {
+  std::string name;
+  std::string pointer;  ///< "/cells/<i>", for messages
+  std::variant<spline::Trivariate, ScenePrimitive> content;
+};
+
+struct SceneOperation {
+  std::string op;
+  std::string pointer;  ///< "/operations/<i>"
+};
+
+struct Scene {
+  std::string source;  ///< the file name messages start with
+  std::string units = "mm";
+  std::vector<std::string> properties;
+  std::vector<SceneCell> cells;
+  std::vector<vmodel::NamedSurface> surfaces;
+  std::vector<SceneOperation> operations;
+};
+
+/// Parses a scene (a model file is a scene too: one without primitives or operations).
+/// @throws trivox::Error (bad_input) naming `source`, the JSON pointer and what was expected
+Scene read_scene_json(std::string_view text, const std::string& source);
+
+/// Reads and parses the scene file at `path` (messages name it as `path.string()`).
+Scene load_scene(const std::filesystem::path& path);
+
+/// What building one primitive cell gave, for the quality report.
+struct PrimitiveBuild {
+  std::string name;     ///< the scene cell's name
+  std::string type;     ///< construct::primitive_type
+  int first_cell = 0;   ///< index of its first cell in the model
+  int cell_count = 0;
+  double exact_volume = 0.0;
+  bool has_field = false;
+  construct::FieldReport field;
+  /// The cells' xyz before the field was applied: the same solids, often in coarser spaces (a
+  /// non-affine field refines them), so validity and volume are cheaper to check on these.
+  std::vector<spline::Trivariate> geometry;
+};
+
+struct SceneBuild {
+  vmodel::VModel model;
+  std::vector<PrimitiveBuild> primitives;
+};
+
+/// Expands the primitives (named `<name>.<part>`, construct/primitives.hpp) and applies their
+/// fields; trivariate cells are kept as they are, in scene order.
+/// @throws trivox::Error (bad_input) for an operation ("<file>: /operations/<i>/op: \"union\"
+///         is not supported yet ..."), for expanded names that collide with other cells, and
+///         for primitive or field parameters construct refuses (with the cell's pointer)
+SceneBuild build_scene(const Scene& scene);
+
+}  // namespace trivox::io

@@ -1,0 +1,295 @@
+#include "trivox/io/scene.hpp"
+
+#include <map>
+
+#include "json_io.hpp"
+
+#include "trivox/error.hpp"
+#include "trivox/io/model_file.hpp"
+
+namespace trivox::io {
+
+namespace {
+
+using namespace json_io;
+using construct::Vec3;
+
+std::string known_operations() {
+  std::string s;
+  for (const char* op : scene_operations) s += (s.empty() ? "" : ", ") + quote(op);
+  return s;
+}
+
+// ------------------------------------------------------------------------------------------
+// Primitive parameters
+
+Vec3 read_point(const Source& src, const json& obj, const std::string& ptr, const char* key, const std::string& what) {
+  const std::string p = child(ptr, key);
+  const std::string expected = "a point or vector [x, y, z]";
+  const json& j = expect_array(src, require(src, obj, ptr, key, what), p, expected);
+  if (j.size() != 3) src.fail(p, plural(static_cast<std::int64_t>(j.size()), "number") + "; expected " + expected);
+  return {read_number_at(src, j[0], p, 0), read_number_at(src, j[1], p, 1), read_number_at(src, j[2], p, 2)};
+}
+
+double read_scalar(const Source& src, const json& obj, const std::string& ptr, const char* key, const std::string& what) {
+  return read_number(src, require(src, obj, ptr, key, what), child(ptr, key));
+}
+
+constexpr const char* primitive_types = "\"box\", \"cylinder\", \"cone\", \"torus\" or \"sphere\"";
+
+construct::Primitive read_primitive_params(const Source& src, const json& j, const std::string& ptr) {
+  const std::string what = "a primitive {\"type\": " + std::string(primitive_types) + ", ...parameters}";
+  expect_object(src, j, ptr, what);
+  const std::string type = read_string(src, require(src, j, ptr, "type", what), child(ptr, "type"),
+                                       std::string("a primitive type: ") + primitive_types);
+  auto pt = [&](const char* key, const char* params) { return read_point(src, j, ptr, key, type + " " + params); };
+  auto num = [&](const char* key, const char* params) { return read_scalar(src, j, ptr, key, type + " " + params); };
+  if (type == "box") {
+    const char* p = "{\"min\": [x, y, z], \"max\": [x, y, z]}";
+    return construct::Box{pt("min", p), pt("max", p)};
+  }
+  if (type == "cylinder") {
+    const char* p = "{\"base\", \"axis\", \"radius\", \"height\"}";
+    return construct::Cylinder{pt("base", p), pt("axis", p), num("radius", p), num("height", p)};
+  }
+  if (type == "cone") {
+    const char* p = "{\"base\", \"axis\", \"radius\", \"top_radius\", \"height\"}";
+    return construct::Cone{pt("base", p), pt("axis", p), num("radius", p), num("top_radius", p), num("height", p)};
+  }
+  if (type == "torus") {
+    const char* p = "{\"center\", \"axis\", \"major\", \"minor\"}";
+    return construct::Torus{pt("center", p), pt("axis", p), num("major", p), num("minor", p)};
+  }
+  if (type == "sphere") {
+    const char* p = "{\"center\", \"radius\"}";
+    return construct::Sphere{pt("center", p), num("radius", p)};
+  }
+  src.fail(child(ptr, "type"), "unknown primitive type " + quote(type) + "; expected " + primitive_types);
+}
+
+// ------------------------------------------------------------------------------------------
+// Fields
+
+/// One value per property: an array of m numbers, or a plain number when m = 1.
+std::vector<double> read_values(const Source& src, const json& j, const std::string& ptr, std::size_t m) {
+  const std::string expected =
+      m == 1 ? "a number or an array of 1 number (one value per property)"
+             : "an array of " + std::to_string(m) + " numbers (one value per property)";
+  if (j.is_number() && m == 1) return {read_number(src, j, ptr)};
+  if (!j.is_array()) fail_type(src, ptr, j, expected);
+  if (j.size() != m) src.fail(ptr, plural(static_cast<std::int64_t>(j.size()), "value") + "; expected " + expected);
+  return read_numbers(src, j, ptr, expected);
+}
+
+/// The two value lists [v0, v1] of a linear or radial field.
+std::array<std::vector<double>, 2> read_value_pair(const Source& src, const json& obj, const std::string& ptr,
+                                                   const std::string& what, std::size_t m) {
+  const std::string p = child(ptr, "values");
+  const std::string expected = "two value lists [v0, v1]";
+  const json& j = expect_array(src, require(src, obj, ptr, "values", what), p, expected);
+  if (j.size() != 2) src.fail(p, plural(static_cast<std::int64_t>(j.size()), "entry") + "; expected " + expected);
+  return {read_values(src, j[0], child(p, std::size_t{0}), m), read_values(src, j[1], child(p, std::size_t{1}), m)};
+}
+
+constexpr const char* field_kinds = "{\"constant\": values}, {\"linear\": {\"from\", \"to\", \"values\"}} or "
+                                    "{\"radial\": {\"center\", \"radius\", \"values\"}}";
+
+construct::Field read_field(const Source& src, const json& j, const std::string& ptr, std::size_t m) {
+  const std::string what = std::string("a property field: ") + field_kinds;
+  expect_object(src, j, ptr, what);
+  int kinds = 0;
+  for (const char* k : {"constant", "linear", "radial"}) kinds += j.contains(k) ? 1 : 0;
+  if (kinds != 1)
+    src.fail(ptr, (kinds == 0 ? std::string("no field kind") : std::to_string(kinds) + " field kinds") +
+                      "; expected exactly one of " + field_kinds);
+  if (const json* c = find(j, "constant")) return construct::ConstantField{read_values(src, *c, child(ptr, "constant"), m)};
+  if (const json* l = find(j, "linear")) {
+    const std::string lp = child(ptr, "linear");
+    const std::string lw = "a linear field {\"from\": [x, y, z], \"to\": [x, y, z], \"values\": [v0, v1]}";
+    expect_object(src, *l, lp, lw);
+    auto [v0, v1] = read_value_pair(src, *l, lp, lw, m);
+    return construct::LinearField{read_point(src, *l, lp, "from", lw), read_point(src, *l, lp, "to", lw), std::move(v0),
+                                  std::move(v1)};
+  }
+  const json& r = *find(j, "radial");
+  const std::string rp = child(ptr, "radial");
+  const std::string rw = "a radial field {\"center\": [x, y, z], \"radius\": r, \"values\": [v_centre, v_radius]}";
+  expect_object(src, r, rp, rw);
+  auto [vc, vr] = read_value_pair(src, r, rp, rw, m);
+  return construct::RadialField{read_point(src, r, rp, "center", rw), read_scalar(src, r, rp, "radius", rw), std::move(vc),
+                                std::move(vr)};
+}
+
+ScenePrimitive read_primitive_cell(const Source& src, const json& cell, const std::string& ptr, std::size_t m) {
+  const std::string pp = child(ptr, "primitive");
+  ScenePrimitive out{read_primitive_params(src, cell["primitive"], pp), {}, std::nullopt};
+  try {
+    construct::check_primitive(out.primitive);
+  } catch (const Error& e) {
+    throw e.within(src.at(pp));
+  }
+  if (const json* t = find(cell["primitive"], "tolerance")) {
+    const std::string tp = child(pp, "tolerance");
+    const double tol = read_number(src, *t, tp);
+    if (!(tol > 0.0 && tol <= 0.01))
+      src.fail(tp, "tolerance " + format_double(tol) + "; expected a relative tolerance in (0, 0.01]");
+    out.options.relative_tolerance = tol;
+  }
+  if (const json* f = find(cell, "field")) {
+    const std::string fp = child(ptr, "field");
+    out.field = read_field(src, *f, fp, m);
+    try {
+      construct::check_field(*out.field, static_cast<int>(m));
+    } catch (const Error& e) {
+      throw e.within(src.at(fp));
+    }
+  } else if (m > 0) {
+    src.fail(ptr, "missing \"field\"; expected a property field (" + std::string(field_kinds) + ") giving the " +
+                      plural(static_cast<std::int64_t>(m), "property") + " of /properties");
+  }
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------
+// Cells, surfaces, operations
+
+std::vector<SceneCell> read_cells(const Source& src, const json& root, const PointShape& shape, std::size_t m,
+                                  NameTable& names) {
+  const json* j = find(root, "cells");
+  if (j == nullptr) return {};
+  const std::string what = "{\"name\", \"trivariate\"} or {\"name\", \"primitive\", \"field\"}";
+  expect_array(src, *j, "/cells", "an array of cell objects " + what);
+  std::vector<SceneCell> out;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string ip = child("/cells", i);
+    const json& item = expect_object(src, (*j)[i], ip, "a cell object " + what);
+    std::string name = read_name(src, item, ip, names);
+    const bool tri = item.contains("trivariate"), prim = item.contains("primitive");
+    if (tri == prim)
+      src.fail(ip, std::string(tri ? "both \"trivariate\" and \"primitive\"" : "neither \"trivariate\" nor \"primitive\"") +
+                       "; expected a cell with exactly one of them");
+    if (tri) {
+      if (item.contains("field"))
+        src.fail(child(ip, "field"), "a field on a trivariate cell; expected fields on primitive cells only (a "
+                                     "trivariate carries its properties in its control points)");
+      out.push_back({std::move(name), ip, read_spline<3>(src, item["trivariate"], child(ip, "trivariate"), shape)});
+    } else {
+      out.push_back({std::move(name), ip, read_primitive_cell(src, item, ip, m)});
+    }
+  }
+  return out;
+}
+
+std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& root, const PointShape& shape,
+                                                NameTable& names) {
+  const json* j = find(root, "surfaces");
+  if (j == nullptr) return {};
+  const std::string what = "{\"name\", \"surface\"}";
+  expect_array(src, *j, "/surfaces", "an array of " + what + " objects");
+  std::vector<vmodel::NamedSurface> out;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string ip = child("/surfaces", i);
+    const json& item = expect_object(src, (*j)[i], ip, "an object " + what);
+    std::string name = read_name(src, item, ip, names);
+    out.push_back({std::move(name), read_spline<2>(src, require(src, item, ip, "surface", what), child(ip, "surface"), shape)});
+  }
+  return out;
+}
+
+std::vector<SceneOperation> read_operations(const Source& src, const json& root) {
+  const json* j = find(root, "operations");
+  if (j == nullptr) return {};
+  const std::string what = "an operation {\"op\": " + known_operations() + ", ...}";
+  expect_array(src, *j, "/operations", "an array of operations, each " + what);
+  std::vector<SceneOperation> out;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string ip = child("/operations", i);
+    const json& item = expect_object(src, (*j)[i], ip, what);
+    const std::string op_ptr = child(ip, "op");
+    const std::string op = read_string(src, require(src, item, ip, "op", what), op_ptr, "an operation name");
+    bool known = false;
+    for (const char* k : scene_operations) known = known || op == k;
+    if (!known) src.fail(op_ptr, "unknown operation " + quote(op) + "; expected one of " + known_operations());
+    out.push_back({op, ip});
+  }
+  return out;
+}
+
+}  // namespace
+
+Scene read_scene_json(std::string_view text, const std::string& source) {
+  const Source src{source};
+  const json root = parse(src, text);
+  expect_object(src, root, "", "a trivox scene object {\"trivox\": 1, \"cells\": [...], ...}");
+  check_version(src, root);
+  Scene scene;
+  scene.source = source;
+  scene.units = read_units(src, root);
+  scene.properties = read_properties(src, root);
+  const PointShape shape = point_shape(scene.properties.size());
+  NameTable names;
+  scene.cells = read_cells(src, root, shape, scene.properties.size(), names);
+  scene.surfaces = read_surfaces(src, root, shape, names);
+  scene.operations = read_operations(src, root);
+  if (scene.cells.empty() && scene.surfaces.empty())
+    src.fail("", "no cells and no surfaces; expected at least one cell (\"cells\") or surface (\"surfaces\")");
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& path) { return read_scene_json(read_file(path), path.string()); }
+
+SceneBuild build_scene(const Scene& scene) {
+  const Source src{scene.source};
+  if (!scene.operations.empty()) {
+    const SceneOperation& op = scene.operations.front();
+    const bool boolean = op.op == "union" || op.op == "intersection" || op.op == "subtraction";
+    src.fail(op.pointer + "/op",
+             quote(op.op) + " is not supported yet (" +
+                 (boolean ? std::string("Booleans of V-models") : op.op == "fillet" ? "trivariate fillets" : "constructor operations in scenes") +
+                 " are later work; `trivox construct` runs one constructor on its own); expected a scene whose "
+                 "\"operations\" list is empty");
+  }
+  SceneBuild out;
+  out.model.units = scene.units;
+  out.model.properties = scene.properties;
+  out.model.surfaces = scene.surfaces;
+  std::map<std::string, std::string> owner;  // model cell name -> scene pointer
+  auto add = [&](std::string name, spline::Trivariate volume, const SceneCell& from) {
+    const auto [it, fresh] = owner.emplace(name, from.pointer);
+    if (!fresh)
+      src.fail(from.pointer + "/name", "cell " + quote(name) + " (from " + quote(from.name) + ") is also a cell of " +
+                                           it->second + "; expected unique cell names (a primitive's cells are "
+                                           "named <name>.<part>)");
+    out.model.cells.push_back({std::move(name), std::move(volume)});
+  };
+  for (const auto& s : scene.surfaces) owner.emplace(s.name, "/surfaces");
+  for (const SceneCell& cell : scene.cells) {
+    if (const auto* t = std::get_if<spline::Trivariate>(&cell.content)) {
+      add(cell.name, *t, cell);
+      continue;
+    }
+    const auto& p = std::get<ScenePrimitive>(cell.content);
+    PrimitiveBuild report;
+    report.name = cell.name;
+    report.type = construct::primitive_type(p.primitive);
+    report.first_cell = static_cast<int>(out.model.cells.size());
+    report.exact_volume = construct::exact_volume(p.primitive);
+    try {
+      auto cells = construct::build_primitive(cell.name, p.primitive, p.options);
+      for (const auto& c : cells) report.geometry.push_back(c.volume);
+      if (p.field) {
+        report.has_field = true;
+        report.field = construct::apply_field(cells, *p.field);
+      }
+      report.cell_count = static_cast<int>(cells.size());
+      for (auto& c : cells) add(std::move(c.name), std::move(c.volume), cell);
+    } catch (const Error& e) {
+      if (std::string_view(e.what()).starts_with(scene.source + ": ")) throw;
+      throw e.within(src.at(cell.pointer));
+    }
+    out.primitives.push_back(std::move(report));
+  }
+  return out;
+}
+
+}  // namespace trivox::io
