@@ -26,7 +26,6 @@ void add_render(CLI::App& app, Common& common);
 void add_merge(CLI::App& app, Common& common);
 void add_validate(CLI::App& app, Common& common);
 void add_build(CLI::App& app, Common& common);
-void add_build(CLI::App& app, Common& common);
 void add_construct(CLI::App& app, Common& common);
 
 /// Parses "a,b,c" into exactly `count` finite numbers.

@@ -25,7 +25,6 @@ int main(int argc, char** argv) {
   trivox::cli::add_merge(app, common);
   trivox::cli::add_validate(app, common);
   trivox::cli::add_build(app, common);
-  trivox::cli::add_build(app, common);
   trivox::cli::add_construct(app, common);
   try {
     app.parse(argc, argv);
