@@ -698,6 +698,9 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
     pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g, pc, H);
     if (pc.k.all_first) {
       pc.bounds = step_bounds_of(all, pc, m);
+      // The sub-box pieces are copies of pc made before its `local` fills up (copying it in the
+      // loop copied the growing table every time: quadratic in local_div^3).
+      Data::Piece sub = pc;
       pc.local.resize(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
       constexpr double S = Data::local_div;
       for (int c = 0; c < Data::local_div; ++c)
@@ -705,7 +708,6 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
           for (int a = 0; a < Data::local_div; ++a) {
             const int idx[3] = {a, b, c};
             Vec3 lo, hi;
-            Data::Piece sub = pc;
             for (std::size_t d = 0; d < 3; ++d) {
               lo[d] = std::max(0.0, (idx[d] - 1) / S);
               hi[d] = std::min(1.0, (idx[d] + 2) / S);

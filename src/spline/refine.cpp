@@ -26,34 +26,50 @@ std::string num(double v) {
   return buf;
 }
 
-/// Boehm's knot insertion (NURBS Book A5.1) of one knot into (knots, C), C holding one control
-/// point per row. Valid for t_mu <= t <= t_{mu+1}.
-void boehm_insert(std::vector<double>& knots, int order, Eigen::MatrixXd& C, double t) {
-  const int p = order - 1;
-  const KnotVector kv(order, knots);
-  int mu = kv.find_span(t);
-  const int n = static_cast<int>(C.rows());
-  Eigen::MatrixXd Q(n + 1, C.cols());
-  for (int i = 0; i <= mu - p; ++i) Q.row(i) = C.row(i);
-  for (int i = std::max(mu - p + 1, 0); i <= mu; ++i) {
-    const double ti = knots[static_cast<std::size_t>(i)];
-    const double a = (t - ti) / (knots[static_cast<std::size_t>(i + p)] - ti);
-    Q.row(i) = a * C.row(i) + (1.0 - a) * C.row(i - 1);
-  }
-  for (int i = mu + 1; i <= n; ++i) Q.row(i) = C.row(i - 1);
-  knots.insert(knots.begin() + mu + 1, t);
-  C = std::move(Q);
-}
-
 Map1D identity_map(const KnotVector& kv) {
   return {kv, Eigen::MatrixXd::Identity(kv.size(), kv.size())};
 }
 
-/// Inserts `add` (sorted or not) into the map's target, composing the matrix.
+/// Inserts `add` (sorted or not) into the map's target, composing the matrix. The matrix is
+/// kept banded while knots go in (a row of a refinement map has at most `order` non-zeros per
+/// original row's band), so each insertion costs O(n * order), not O(n * columns): thousands of
+/// spans (Bezier extraction of a fine revolution) stay fast. Each new row is Boehm's convex
+/// combination, the same arithmetic as on dense rows.
 Map1D insert_into(Map1D m, std::vector<double> add) {
   std::sort(add.begin(), add.end());
   std::vector<double> knots = m.to.knots();
   const int order = m.to.order();
+  const int p = order - 1;
+  struct Row {
+    int first = 0;
+    std::vector<double> c;  // T(i, first + k) = c[k]
+  };
+  const int cols = static_cast<int>(m.T.cols());
+  std::vector<Row> rows(static_cast<std::size_t>(m.T.rows()));
+  for (int i = 0; i < static_cast<int>(m.T.rows()); ++i) {
+    int a = 0, b = cols - 1;
+    while (a < cols && m.T(i, a) == 0.0) ++a;
+    while (b > a && m.T(i, b) == 0.0) --b;
+    Row& r = rows[static_cast<std::size_t>(i)];
+    r.first = a < cols ? a : 0;
+    for (int k = a; k <= b && a < cols; ++k) r.c.push_back(m.T(i, k));
+  }
+  const auto combine = [](const Row& x, double ax, const Row& y, double ay) {
+    Row out;
+    if (x.c.empty() && y.c.empty()) return out;
+    const int lo = x.c.empty() ? y.first : y.c.empty() ? x.first : std::min(x.first, y.first);
+    const int hi = std::max(x.c.empty() ? lo : x.first + static_cast<int>(x.c.size()),
+                            y.c.empty() ? lo : y.first + static_cast<int>(y.c.size()));
+    out.first = lo;
+    out.c.assign(static_cast<std::size_t>(hi - lo), 0.0);
+    for (std::size_t k = 0; k < out.c.size(); ++k) {
+      const int col = lo + static_cast<int>(k);
+      const double xv = col >= x.first && col < x.first + static_cast<int>(x.c.size()) ? x.c[static_cast<std::size_t>(col - x.first)] : 0.0;
+      const double yv = col >= y.first && col < y.first + static_cast<int>(y.c.size()) ? y.c[static_cast<std::size_t>(col - y.first)] : 0.0;
+      out.c[k] = ax * xv + ay * yv;
+    }
+    return out;
+  };
   for (double t : add) {
     if (!(t >= m.to.front() && t <= m.to.back()))
       throw Error("knot " + num(t) + " outside the domain [" + num(m.to.front()) + ", " + num(m.to.back()) +
@@ -62,8 +78,25 @@ Map1D insert_into(Map1D m, std::vector<double> add) {
     if (mult >= order)
       throw Error("knot " + num(t) + " already has multiplicity " + std::to_string(mult) +
                   "; expected at most the order (" + std::to_string(order) + ")");
-    boehm_insert(knots, order, m.T, t);
+    // The span t_mu <= t < t_mu+1 (at the right end: the last non-empty span), as KnotVector::find_span.
+    const int n = static_cast<int>(knots.size()) - order;
+    int mu = static_cast<int>(std::upper_bound(knots.begin(), knots.end(), t) - knots.begin()) - 1;
+    mu = std::clamp(mu, p, n - 1);
+    while (mu > p && knots[static_cast<std::size_t>(mu)] == knots[static_cast<std::size_t>(mu + 1)]) --mu;
+    // Boehm (NURBS Book A5.1): rows mu-p+1..mu become convex combinations, the rest shift.
+    std::vector<Row> fresh;
+    for (int i = mu - p + 1; i <= mu; ++i) {
+      const double ti = knots[static_cast<std::size_t>(i)];
+      const double a = (t - ti) / (knots[static_cast<std::size_t>(i + p)] - ti);
+      fresh.push_back(combine(rows[static_cast<std::size_t>(i)], a, rows[static_cast<std::size_t>(i - 1)], 1.0 - a));
+    }
+    rows.erase(rows.begin() + (mu - p + 1), rows.begin() + mu);
+    rows.insert(rows.begin() + (mu - p + 1), std::make_move_iterator(fresh.begin()), std::make_move_iterator(fresh.end()));
+    knots.insert(knots.begin() + mu + 1, t);
   }
+  m.T = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), cols);
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    for (std::size_t k = 0; k < rows[i].c.size(); ++k) m.T(static_cast<Eigen::Index>(i), rows[i].first + static_cast<Eigen::Index>(k)) = rows[i].c[k];
   m.to = KnotVector(order, std::move(knots));
   return m;
 }
