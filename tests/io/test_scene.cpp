@@ -1,0 +1,140 @@
+// The scene reader and builder (io/scene.hpp). Truths: the documented scene format
+// (docs/model-format.md, "Scenes"): what each key means, which cells a primitive expands to, and
+// that every malformed scene is refused with the file, the JSON pointer and what was expected.
+#include <catch2/catch.hpp>
+
+#include <string>
+
+#include "io_test_util.hpp"
+#include "trivox/io/scene.hpp"
+
+using namespace trivox;
+using trivox::io::test::check_message;
+using trivox::io::test::error_of;
+
+namespace {
+
+/// A scene with one property "d" and the given cells and operations.
+std::string scene(const std::string& cells, const std::string& ops = "") {
+  return R"({"trivox": 1, "units": "cm", "properties": ["d"], "cells": [)" + cells + R"(], "operations": [)" + ops + "]}";
+}
+
+const std::string ball = R"({"name": "ball", "primitive": {"type": "sphere", "center": [1, 2, 3], "radius": 2},
+                              "field": {"constant": 0.5}})";
+const std::string block = R"({"name": "block", "trivariate": {"orders": [2, 2, 2],
+  "knots": [[0, 0, 1, 1], [0, 0, 1, 1], [0, 0, 1, 1]],
+  "points": [[0,0,0,1], [1,0,0,1], [0,1,0,1], [1,1,0,1], [0,0,1,1], [1,0,1,1], [0,1,1,1], [1,1,1,1]]}})";
+
+std::string read_error(const std::string& text) {
+  return error_of([&] { io::read_scene_json(text, "s.json"); });
+}
+std::string build_error(const std::string& text) {
+  return error_of([&] { io::build_scene(io::read_scene_json(text, "s.json")); });
+}
+
+}  // namespace
+
+TEST_CASE("scene: primitives expand to named cells with their fields", "[scene]") {
+  const auto s = io::read_scene_json(scene(ball + "," + block), "s.json");
+  CHECK(s.units == "cm");
+  CHECK(s.properties == std::vector<std::string>{"d"});
+  REQUIRE(s.cells.size() == 2);
+  CHECK(s.cells[0].pointer == "/cells/0");
+  const auto built = io::build_scene(s);
+  REQUIRE(built.model.cells.size() == 8);
+  CHECK(built.model.cells[0].name == "ball.core");
+  CHECK(built.model.cells[6].name == "ball.z1");
+  CHECK(built.model.cells[7].name == "block");
+  REQUIRE(built.primitives.size() == 1);
+  CHECK(built.primitives[0].type == "sphere");
+  CHECK(built.primitives[0].cell_count == 7);
+  CHECK(built.primitives[0].exact_volume == Approx(4.0 / 3.0 * 3.14159265358979323846 * 8));
+  CHECK(built.primitives[0].field.exact);
+  for (const auto& c : built.model.cells) {
+    CHECK(c.volume.dim() == 4);
+    CHECK(std::abs(c.volume.eval({0.3, 0.6, 0.9})[3] - (c.name == "block" ? 1.0 : 0.5)) < 1e-15);
+  }
+  // A ball's centre cell is centred on the ball.
+  const auto centre = built.model.cells[0].volume.eval({0.5, 0.5, 0.5});
+  CHECK(centre[0] == Approx(1.0));
+  CHECK(centre[1] == Approx(2.0));
+  CHECK(centre[2] == Approx(3.0));
+}
+
+TEST_CASE("scene: field forms and the primitive tolerance", "[scene]") {
+  const std::string two = R"({"trivox": 1, "properties": ["a", "b"], "cells": [
+    {"name": "c", "primitive": {"type": "cylinder", "base": [0, 0, 0], "axis": [0, 0, 1], "radius": 1, "height": 2,
+                                "tolerance": 1e-3},
+     "field": {"linear": {"from": [0, 0, -1], "to": [0, 0, 3], "values": [[0, 1], [1, 0]]}}}]})";
+  const auto built = io::build_scene(io::read_scene_json(two, "s.json"));
+  REQUIRE(built.model.cells.size() == 5);
+  CHECK(built.primitives[0].field.exact);
+  const auto x = built.model.cells[2].volume.eval({0.2, 0.7, 0.5});
+  CHECK(std::abs(x[3] - (x[2] + 1) / 4) < 1e-12);
+  CHECK(std::abs(x[4] - (1 - (x[2] + 1) / 4)) < 1e-12);
+  // No properties: no field needed.
+  const auto plain = io::build_scene(io::read_scene_json(
+      R"({"trivox": 1, "cells": [{"name": "t", "primitive": {"type": "torus", "center": [0, 0, 0], "axis": [0, 0, 1],
+          "major": 3, "minor": 1}}]})", "s.json"));
+  CHECK(plain.model.cells.size() == 5);
+  CHECK(plain.model.cells[0].volume.dim() == 3);
+  CHECK_FALSE(plain.primitives[0].has_field);
+}
+
+TEST_CASE("scene: malformed scenes name the file, the place and what was expected", "[scene]") {
+  check_message(read_error("{\"trivox\": 1, \"cells\": [}"), {"s.json: line 1", "malformed JSON"});
+  check_message(read_error(R"({"trivox": 2, "cells": []})"), {"s.json: /trivox: format version 2; expected 1"});
+  check_message(read_error(scene("")), {"s.json: top level: no cells and no surfaces; expected"});
+  check_message(read_error(scene(R"({"name": "a"})")),
+                {"s.json: /cells/0: neither \"trivariate\" nor \"primitive\"; expected"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": 3})")), {"s.json: /cells/0/primitive: found the number 3; expected a primitive"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"radius": 1}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive: missing \"type\"; expected a primitive"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "egg"}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive/type: unknown primitive type \"egg\"; expected \"box\", \"cylinder\""});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "sphere", "center": [0, 0]}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive/center: 2 numbers; expected a point or vector [x, y, z]"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "sphere", "center": [0, 0, 0]}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive: missing \"radius\"; expected sphere {\"center\", \"radius\"}"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "sphere", "center": [0, "x", 0], "radius": 1}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive/center/1: found the string \"x\"; expected a number"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "cylinder", "base": [0, 0, 0], "axis": [0, 0, 0], "radius": 1, "height": 1}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive: cylinder axis (0, 0, 0) has zero length; expected a non-zero direction"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "cone", "base": [0, 0, 0], "axis": [0, 0, 1], "radius": 1, "top_radius": 0, "height": 1}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive: cone top_radius 0", "expected a positive top_radius"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "tolerance": 0.5}, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/primitive/tolerance: tolerance 0.5; expected a relative tolerance in (0, 0.01]"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}})")),
+                {"s.json: /cells/0: missing \"field\"; expected a property field"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {}})")),
+                {"s.json: /cells/0/field: no field kind; expected exactly one of"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {"constant": [1, 2]}})")),
+                {"s.json: /cells/0/field/constant: 2 values; expected a number or an array of 1 number"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {"linear": {"from": [0, 0, 0], "to": [1, 0, 0], "values": [0]}}})")),
+                {"s.json: /cells/0/field/linear/values: 1 entry; expected two value lists [v0, v1]"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {"linear": {"from": [0, 0, 0], "to": [0, 0, 0], "values": [0, 1]}}})")),
+                {"s.json: /cells/0/field: linear field from = to; expected two distinct points"});
+  check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {"radial": {"center": [0, 0, 0], "radius": -2, "values": [0, 1]}}})")),
+                {"s.json: /cells/0/field: radial field radius -2; expected a positive finite number"});
+  check_message(read_error(scene(block.substr(0, block.size() - 1) + R"(, "field": {"constant": 1}})")),
+                {"s.json: /cells/0/field: a field on a trivariate cell; expected fields on primitive cells only"});
+  check_message(read_error(scene(ball + "," + ball)), {"s.json: /cells/1/name: \"ball\" is also the name of /cells/0; expected"});
+  check_message(read_error(scene(ball, R"({"op": 7})")), {"s.json: /operations/0/op: found the number 7; expected an operation name"});
+  check_message(read_error(scene(ball, R"({"a": 1})")), {"s.json: /operations/0: missing \"op\"; expected an operation"});
+  check_message(read_error(scene(ball, R"({"op": "blend"})")),
+                {"s.json: /operations/0/op: unknown operation \"blend\"; expected one of \"union\", \"intersection\", "
+                 "\"subtraction\", \"fillet\", \"ruled\", \"extrude\", \"revolve\", \"boolean_sum\", \"half_boolean_sum\", \"sweep\""});
+}
+
+TEST_CASE("scene: operations are not built yet; expanded names must stay unique", "[scene]") {
+  for (const char* op : io::scene_operations) {
+    INFO(op);
+    check_message(build_error(scene(ball, std::string(R"({"op": ")") + op + "\"}")),
+                  {"s.json: /operations/0/op: \"" + std::string(op) + "\" is not supported yet", "expected"});
+  }
+  const std::string clash = R"({"name": "ball.core", "trivariate": {"orders": [2, 2, 2],
+    "knots": [[0, 0, 1, 1], [0, 0, 1, 1], [0, 0, 1, 1]],
+    "points": [[0,0,0,1], [1,0,0,1], [0,1,0,1], [1,1,0,1], [0,0,1,1], [1,0,1,1], [0,1,1,1], [1,1,1,1]]}})";
+  check_message(build_error(scene(clash + "," + ball)),
+                {"s.json: /cells/1/name: cell \"ball.core\" (from \"ball\") is also a cell of /cells/0; expected unique cell names"});
+}
