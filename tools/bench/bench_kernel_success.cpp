@@ -24,7 +24,8 @@
 // are sorted along the curve's direction (x for bottom and top, y for left and right);
 // "unsorted" as the fifth argument draws them as they come.
 //
-// Usage: trivox_bench_kernel_success [samples=1000] [threads=2] [seed=2023] [op|all] [unsorted]
+// Usage: trivox_bench_kernel_success [samples=1000] [threads=2] [seed=2023] [op|all]
+//                                    [sorted|unsorted] [cubic|quartic|quadratic|all]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -255,8 +256,10 @@ int main(int argc, char** argv) {
   const std::uint64_t seed = argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 2023;
   const std::string only = argc > 4 ? argv[4] : "";
   const bool sorted = !(argc > 5 && std::string(argv[5]) == "unsorted");
+  const std::string only_kind = argc > 6 ? argv[6] : "all";
   if (samples < 1 || threads < 1) {
-    std::fprintf(stderr, "usage: %s [samples >= 1] [threads >= 1] [seed] [op name filter]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s [samples >= 1] [threads >= 1] [seed] [op|all] [sorted|unsorted] [cubic|quartic|quadratic|all]\n",
+                 argv[0]);
     return 2;
   }
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
@@ -273,6 +276,7 @@ int main(int argc, char** argv) {
     for (Kind kind : {Kind::cubic, Kind::quartic, Kind::quadratic}) {
       ++dataset;
       if (!only.empty() && only != "all" && only != construct::kernel_op_name(op)) continue;
+      if (only_kind != "all" && std::string(kind_name(kind)).find(only_kind) == std::string::npos) continue;
       const auto t0 = Clock::now();
       // Screen candidates in parallel batches, keep them in index order.
       std::vector<Candidate> kept;
