@@ -275,3 +275,19 @@ TEST_CASE("a box with a dented top: the kernel lies below every tangent plane an
   }
   CHECK(previous > 1.0);
 }
+
+TEST_CASE("a degenerate face contributes no constraint: a triangular prism", "[kernel]") {
+  // Face u0 collapses to the z axis; the cell is the prism over the triangle (0,0) (1,0) (1,1),
+  // height 2: kernel = the prism, volume 1, centroid (2/3, 1/3, 1).
+  std::vector<double> pts;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) pts.insert(pts.end(), {double(i), double(i * j), 2.0 * k});
+  const Trivariate t({KnotVector::bezier(2), KnotVector::bezier(2), KnotVector::bezier(2)}, 3, pts);
+  const auto k = geom::spatial_kernel(t);
+  REQUIRE_FALSE(k.empty());
+  CHECK(k.volume == Approx(1.0).epsilon(1e-10));
+  CHECK(k.centroid[0] == Approx(2.0 / 3).epsilon(1e-10));
+  CHECK(k.centroid[1] == Approx(1.0 / 3).epsilon(1e-10));
+  CHECK(k.centroid[2] == Approx(1.0).epsilon(1e-10));
+}
