@@ -1,0 +1,416 @@
+#include "trivox/geom/surface_intersection.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <string>
+
+#include "trivox/error.hpp"
+#include "trivox/spline/fit.hpp"
+#include "trivox/spline/refine.hpp"
+
+namespace trivox::geom {
+
+namespace {
+
+using spline::Surface;
+using V3 = Eigen::Vector3d;
+
+struct Frame {
+  V3 x, du, dv;
+};
+
+Frame frame(const Surface& s, const std::array<double, 2>& t, std::vector<double>& buf) {
+  buf.resize(static_cast<std::size_t>(3 * s.dim()));
+  s.eval_derivatives(t, 1, buf.data());
+  const double* b = buf.data();
+  const int k = s.dim();
+  return {V3(b[0], b[1], b[2]), V3(b[k], b[k + 1], b[k + 2]), V3(b[2 * k], b[2 * k + 1], b[2 * k + 2])};
+}
+
+struct Box2 {
+  std::array<double, 2> lo, hi;
+};
+
+Box2 domain_of(const Surface& s) { return {{s.domain(0)[0], s.domain(1)[0]}, {s.domain(0)[1], s.domain(1)[1]}}; }
+
+/// The extra equation of a Newton solve besides S_1 = S_2: none (minimum-norm steps), a plane
+/// (X - q) . n = 0, or one parameter held at a value (0..3: u1, v1, u2, v2).
+struct Constraint {
+  enum Kind { none, plane, parameter } kind = none;
+  V3 q{0, 0, 0}, n{0, 0, 0};
+  int index = 0;
+  double value = 0.0;
+};
+
+class Solver {
+public:
+  Solver(const Surface& a, const Surface& b, double tol) : a_(a), b_(b), da_(domain_of(a)), db_(domain_of(b)), tol_(tol) {}
+
+  /// Newton from p (parameters clamped to the domains); true when |S_1 - S_2| < tol and the
+  /// constraint holds to tol.
+  bool solve(IntersectionPoint& p, const Constraint& c, int max_iter = 25) const {
+    std::array<double, 4> t{p.uv1[0], p.uv1[1], p.uv2[0], p.uv2[1]};
+    clamp(t);
+    for (int it = 0; it < max_iter; ++it) {
+      const Frame f1 = frame(a_, {t[0], t[1]}, buf1_), f2 = frame(b_, {t[2], t[3]}, buf2_);
+      const V3 F = f1.x - f2.x;
+      double g = 0.0;
+      if (c.kind == Constraint::plane) g = (f1.x - c.q).dot(c.n);
+      if (c.kind == Constraint::parameter) g = t[static_cast<std::size_t>(c.index)] - c.value;
+      if (F.norm() < tol_ && std::abs(g) < tol_) {
+        p.uv1 = {t[0], t[1]};
+        p.uv2 = {t[2], t[3]};
+        p.xyz = {0.5 * (f1.x[0] + f2.x[0]), 0.5 * (f1.x[1] + f2.x[1]), 0.5 * (f1.x[2] + f2.x[2])};
+        return true;
+      }
+      Eigen::Matrix<double, 3, 4> J;
+      J.col(0) = f1.du;
+      J.col(1) = f1.dv;
+      J.col(2) = -f2.du;
+      J.col(3) = -f2.dv;
+      Eigen::Vector4d step;
+      if (c.kind == Constraint::none) {
+        const Eigen::Matrix3d JJ = J * J.transpose();
+        const Eigen::Vector3d y = JJ.ldlt().solve(-F);
+        step = J.transpose() * y;
+      } else {
+        Eigen::Matrix4d A;
+        A.topRows<3>() = J;
+        Eigen::Vector4d r;
+        r.head<3>() = -F;
+        if (c.kind == Constraint::plane) {
+          A.row(3) << c.n.dot(f1.du), c.n.dot(f1.dv), 0.0, 0.0;
+        } else {
+          A.row(3).setZero();
+          A(3, c.index) = 1.0;
+        }
+        r(3) = -g;
+        step = A.fullPivLu().solve(r);
+      }
+      if (!step.allFinite()) return false;
+      for (std::size_t k = 0; k < 4; ++k) t[k] += step(static_cast<Eigen::Index>(k));
+      clamp(t);
+    }
+    return false;
+  }
+
+  bool on_boundary(const IntersectionPoint& p, int& index, double& value) const {
+    const double eps = 1e-12;
+    const double v[4] = {p.uv1[0], p.uv1[1], p.uv2[0], p.uv2[1]};
+    for (int k = 0; k < 4; ++k) {
+      const Box2& d = k < 2 ? da_ : db_;
+      const double lo = d.lo[static_cast<std::size_t>(k & 1)], hi = d.hi[static_cast<std::size_t>(k & 1)];
+      const double w = (hi - lo) * eps;
+      if (v[k] <= lo + w || v[k] >= hi - w) {
+        index = k;
+        value = v[k] <= lo + w ? lo : hi;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  /// Unit tangent n_1 x n_2 at p (zero where the surfaces touch tangentially), and the rate of
+  /// change of the four parameters along it.
+  bool tangent(const IntersectionPoint& p, V3& T, Eigen::Vector4d& dt) const {
+    const Frame f1 = frame(a_, p.uv1, buf1_), f2 = frame(b_, p.uv2, buf2_);
+    const V3 n1 = f1.du.cross(f1.dv), n2 = f2.du.cross(f2.dv);
+    const V3 c = n1.cross(n2);
+    const double scale = n1.norm() * n2.norm();
+    if (!(scale > 0) || c.norm() < 1e-9 * scale) return false;
+    T = c.normalized();
+    Eigen::Matrix<double, 3, 2> A1, A2;
+    A1 << f1.du, f1.dv;
+    A2 << f2.du, f2.dv;
+    dt.head<2>() = A1.colPivHouseholderQr().solve(T);
+    dt.tail<2>() = A2.colPivHouseholderQr().solve(T);
+    return dt.allFinite();
+  }
+
+  bool inside(const std::array<double, 4>& t) const {
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Box2& d = k < 2 ? da_ : db_;
+      if (t[k] < d.lo[k & 1] || t[k] > d.hi[k & 1]) return false;
+    }
+    return true;
+  }
+
+  void clamp(std::array<double, 4>& t) const {
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Box2& d = k < 2 ? da_ : db_;
+      t[k] = std::clamp(t[k], d.lo[k & 1], d.hi[k & 1]);
+    }
+  }
+
+private:
+  const Surface& a_;
+  const Surface& b_;
+  Box2 da_, db_;
+  double tol_;
+  mutable std::vector<double> buf1_, buf2_;
+};
+
+std::array<double, 6> control_box(const Surface& s) {
+  std::array<double, 6> b{1e300, 1e300, 1e300, -1e300, -1e300, -1e300};
+  for (int i = 0; i < s.size(); ++i)
+    for (std::size_t d = 0; d < 3; ++d) {
+      b[d] = std::min(b[d], s.point(i)[d]);
+      b[d + 3] = std::max(b[d + 3], s.point(i)[d]);
+    }
+  return b;
+}
+
+double diag(const std::array<double, 6>& b) { return std::hypot(b[3] - b[0], b[4] - b[1], b[5] - b[2]); }
+
+bool overlap(const std::array<double, 6>& a, const std::array<double, 6>& b, double pad) {
+  for (std::size_t d = 0; d < 3; ++d)
+    if (a[d] > b[d + 3] + pad || b[d] > a[d + 3] + pad) return false;
+  return true;
+}
+
+/// Splits a Bezier patch in the parameter direction along which its control net is longer.
+std::pair<Surface, Surface> halve(const Surface& s) {
+  double len[2] = {0.0, 0.0};
+  const auto n = s.counts();
+  for (int j = 0; j < n[1]; ++j)
+    for (int i = 0; i + 1 < n[0]; ++i) {
+      const auto p = s.point(s.row({i, j})), q = s.point(s.row({i + 1, j}));
+      len[0] += std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+    }
+  for (int j = 0; j + 1 < n[1]; ++j)
+    for (int i = 0; i < n[0]; ++i) {
+      const auto p = s.point(s.row({i, j})), q = s.point(s.row({i, j + 1}));
+      len[1] += std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+    }
+  const int d = len[0] / n[1] >= len[1] / n[0] ? 0 : 1;
+  const auto dom = s.domain(d);
+  return spline::split(s, d, 0.5 * (dom[0] + dom[1]));
+}
+
+void find_seeds(const Surface& p1, const Surface& p2, double small, double pad, const Solver& solver, int depth,
+                std::vector<IntersectionPoint>& seeds) {
+  const auto b1 = control_box(p1), b2 = control_box(p2);
+  if (!overlap(b1, b2, pad)) return;
+  const double d1 = diag(b1), d2 = diag(b2);
+  if ((d1 <= small && d2 <= small) || depth >= 24) {
+    IntersectionPoint p;
+    p.uv1 = {0.5 * (p1.domain(0)[0] + p1.domain(0)[1]), 0.5 * (p1.domain(1)[0] + p1.domain(1)[1])};
+    p.uv2 = {0.5 * (p2.domain(0)[0] + p2.domain(0)[1]), 0.5 * (p2.domain(1)[0] + p2.domain(1)[1])};
+    if (solver.solve(p, {})) seeds.push_back(p);
+    return;
+  }
+  if (d1 >= d2) {
+    const auto [l, r] = halve(p1);
+    find_seeds(l, p2, small, pad, solver, depth + 1, seeds);
+    find_seeds(r, p2, small, pad, solver, depth + 1, seeds);
+  } else {
+    const auto [l, r] = halve(p2);
+    find_seeds(p1, l, small, pad, solver, depth + 1, seeds);
+    find_seeds(p1, r, small, pad, solver, depth + 1, seeds);
+  }
+}
+
+double dist(const IntersectionPoint& a, const IntersectionPoint& b) {
+  return std::hypot(a.xyz[0] - b.xyz[0], a.xyz[1] - b.xyz[1], a.xyz[2] - b.xyz[2]);
+}
+
+/// Distance from point x to the polyline of `pts`.
+double polyline_distance(const std::vector<IntersectionPoint>& pts, const std::array<double, 3>& x) {
+  double best = 1e300;
+  const V3 p(x[0], x[1], x[2]);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const V3 a(pts[i].xyz[0], pts[i].xyz[1], pts[i].xyz[2]);
+    best = std::min(best, (p - a).norm());
+    if (i + 1 == pts.size()) break;
+    const V3 b(pts[i + 1].xyz[0], pts[i + 1].xyz[1], pts[i + 1].xyz[2]);
+    const V3 ab = b - a;
+    const double L = ab.squaredNorm();
+    if (L == 0) continue;
+    const double s = std::clamp((p - a).dot(ab) / L, 0.0, 1.0);
+    best = std::min(best, (p - (a + s * ab)).norm());
+  }
+  return best;
+}
+
+/// One branch from `start` in direction `sign`. Returns the points after start; `closed` when
+/// the branch came back to start.
+std::vector<IntersectionPoint> march(const Solver& solver, const IntersectionPoint& start, double sign, double hmax,
+                                     double tol, bool& closed) {
+  std::vector<IntersectionPoint> out;
+  closed = false;
+  IntersectionPoint cur = start;
+  double h = hmax;
+  V3 T;
+  Eigen::Vector4d dt;
+  if (!solver.tangent(cur, T, dt)) return out;
+  T *= sign;
+  dt *= sign;
+  const double hmin = std::max(10 * tol, hmax * 1e-6);
+  double travelled = 0.0;
+  for (int steps = 0; steps < 200000; ++steps) {
+    const std::array<double, 4> t0{cur.uv1[0], cur.uv1[1], cur.uv2[0], cur.uv2[1]};
+    std::array<double, 4> pred;
+    for (std::size_t k = 0; k < 4; ++k) pred[k] = t0[k] + h * dt(static_cast<Eigen::Index>(k));
+    IntersectionPoint next;
+    bool ok = false;
+    bool ends = false;
+    if (!solver.inside(pred)) {
+      // The step leaves a parameter rectangle: solve for the point on that boundary, between here
+      // and the prediction, with the leaving parameter held there.
+      int idx = -1;
+      double frac = 2.0, value = 0.0;
+      std::array<double, 4> clamped = pred;
+      solver.clamp(clamped);
+      for (std::size_t k = 0; k < 4; ++k)
+        if (clamped[k] != pred[k]) {
+          const double f = (clamped[k] - t0[k]) / (pred[k] - t0[k]);
+          if (f < frac) frac = f, idx = static_cast<int>(k), value = clamped[k];
+        }
+      next.uv1 = {t0[0] + frac * h * dt(0), t0[1] + frac * h * dt(1)};
+      next.uv2 = {t0[2] + frac * h * dt(2), t0[3] + frac * h * dt(3)};
+      Constraint c;
+      c.kind = Constraint::parameter;
+      c.index = idx;
+      c.value = value;
+      ok = solver.solve(next, c) && dist(next, cur) < 2.5 * h;
+      ends = ok;
+    } else {
+      next.uv1 = {pred[0], pred[1]};
+      next.uv2 = {pred[2], pred[3]};
+      Constraint c;
+      c.kind = Constraint::plane;
+      c.n = T;
+      c.q = V3(cur.xyz[0], cur.xyz[1], cur.xyz[2]) + h * T;
+      ok = solver.solve(next, c) && dist(next, cur) < 2.5 * h;
+    }
+    V3 Tn;
+    Eigen::Vector4d dtn;
+    if (ok && !ends) {
+      ok = solver.tangent(next, Tn, dtn);
+      if (ok) {
+        if (Tn.dot(T) < 0) Tn = -Tn, dtn = -dtn;
+        ok = Tn.dot(T) > std::cos(10.0 * M_PI / 180.0);
+      }
+    }
+    if (!ok) {
+      h *= 0.5;
+      if (h < hmin) return out;  // cannot continue (a tangential contact or a singular point)
+      continue;
+    }
+    // Back at the start, in xyz and in both parameter spaces (a curve that reaches a periodic
+    // surface's seam is near its start in xyz only, and goes on to the boundary): closed.
+    travelled += dist(next, cur);
+    double dpar = 0.0, step_par = 0.0;
+    for (std::size_t k = 0; k < 2; ++k) {
+      dpar = std::max({dpar, std::abs(next.uv1[k] - start.uv1[k]), std::abs(next.uv2[k] - start.uv2[k])});
+      step_par = std::max({step_par, std::abs(next.uv1[k] - cur.uv1[k]), std::abs(next.uv2[k] - cur.uv2[k])});
+    }
+    if (out.size() >= 3 && travelled > 3 * hmax && dist(next, start) < 1.5 * h && dpar <= 2 * step_par) {
+      closed = true;
+      return out;
+    }
+    out.push_back(next);
+    if (ends) return out;
+    cur = next;
+    T = Tn;
+    dt = dtn;
+    h = std::min(hmax, h * 1.5);
+  }
+  return out;
+}
+
+/// Cubic interpolation of the points (chord length), closing the loop for closed curves.
+void fit_curves(IntersectionCurve& c) {
+  std::vector<IntersectionPoint> pts = c.points;
+  if (c.closed) pts.push_back(pts.front());
+  if (pts.size() < 2) return;
+  std::vector<double> xyz, uv1, uv2;
+  for (const auto& p : pts) {
+    xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
+    uv1.insert(uv1.end(), p.uv1.begin(), p.uv1.end());
+    uv2.insert(uv2.end(), p.uv2.begin(), p.uv2.end());
+  }
+  const auto t = spline::chord_length_params(xyz, 3);
+  const int order = std::min<int>(4, static_cast<int>(pts.size()));
+  const auto kv = spline::interpolation_knots(t, order);
+  c.xyz = spline::interpolate_curve(t, 3, xyz, kv);
+  c.uv1 = spline::interpolate_curve(t, 2, uv1, kv);
+  c.uv2 = spline::interpolate_curve(t, 2, uv2, kv);
+}
+
+}  // namespace
+
+std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surface& b, const IntersectionOptions& options) {
+  if (a.dim() < 3 || b.dim() < 3)
+    throw Error("surface intersection of surfaces with " + std::to_string(a.dim()) + " and " + std::to_string(b.dim()) +
+                " coordinates; expected at least 3 (xyz)");
+  if (!(options.tolerance > 0) || !(options.max_step > 0))
+    throw Error("surface intersection tolerance " + std::to_string(options.tolerance) + " and step " +
+                std::to_string(options.max_step) + "; expected positive values");
+  const Solver solver(a, b, options.tolerance);
+  const double size = std::max(diag(control_box(a)), diag(control_box(b)));
+  const double hmax = options.max_step * size;
+  std::vector<IntersectionPoint> seeds;
+  const auto pa = spline::bezier_pieces(a), pb = spline::bezier_pieces(b);
+  for (const auto& p1 : pa)
+    for (const auto& p2 : pb) find_seeds(p1, p2, 0.5 * hmax, options.tolerance, solver, 0, seeds);
+  std::vector<IntersectionCurve> out;
+  for (const auto& seed : seeds) {
+    bool known = false;
+    for (const auto& c : out)
+      if (polyline_distance(c.points, seed.xyz) < 0.75 * hmax) known = true;
+    if (known) continue;
+    IntersectionCurve c;
+    bool closed = false, closed_back = false;
+    const auto fwd = march(solver, seed, 1.0, hmax, options.tolerance, closed);
+    std::vector<IntersectionPoint> back;
+    if (!closed) back = march(solver, seed, -1.0, hmax, options.tolerance, closed_back);
+    c.points.assign(back.rbegin(), back.rend());
+    c.points.push_back(seed);
+    c.points.insert(c.points.end(), fwd.begin(), fwd.end());
+    c.closed = closed;
+    // Densify until the xyz curve's midpoints lie on both surfaces.
+    for (int pass = 0; pass < 6 && c.points.size() >= 2; ++pass) {
+      fit_curves(c);
+      std::vector<IntersectionPoint> dense;
+      bool all_good = true;
+      const auto t = spline::chord_length_params(
+          [&] {
+            std::vector<double> v;
+            for (const auto& p : c.points) v.insert(v.end(), p.xyz.begin(), p.xyz.end());
+            if (c.closed) v.insert(v.end(), c.points.front().xyz.begin(), c.points.front().xyz.end());
+            return v;
+          }(),
+          3);
+      const std::size_t n = c.points.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        dense.push_back(c.points[i]);
+        if (!c.closed && i + 1 == n) break;
+        const double tm = 0.5 * (t[i] + t[i + 1]);
+        const auto x = c.xyz.eval({tm}), u1 = c.uv1.eval({tm}), u2 = c.uv2.eval({tm});
+        IntersectionPoint m;
+        m.uv1 = {u1[0], u1[1]};
+        m.uv2 = {u2[0], u2[1]};
+        const IntersectionPoint& q = c.points[(i + 1) % n];
+        Constraint k;
+        k.kind = Constraint::plane;
+        k.n = V3(q.xyz[0] - c.points[i].xyz[0], q.xyz[1] - c.points[i].xyz[1], q.xyz[2] - c.points[i].xyz[2]).normalized();
+        k.q = V3(x[0], x[1], x[2]);
+        if (!solver.solve(m, k)) continue;
+        if (std::hypot(m.xyz[0] - x[0], m.xyz[1] - x[1], m.xyz[2] - x[2]) > options.tolerance) {
+          all_good = false;
+          dense.push_back(m);
+        }
+      }
+      if (all_good) break;
+      c.points = std::move(dense);
+    }
+    if (c.points.size() >= 2) fit_curves(c);
+    out.push_back(std::move(c));
+  }
+  return out;
+}
+
+}  // namespace trivox::geom
