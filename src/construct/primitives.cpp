@@ -441,8 +441,8 @@ void check_primitive(const Primitive& p) {
 }
 
 std::vector<PrimitiveCell> build_primitive(const std::string& name, const Primitive& p, const PrimitiveOptions& options) {
-  if (!(options.relative_tolerance > 0.0 && options.relative_tolerance <= 0.01))
-    throw Error("primitive tolerance " + num(options.relative_tolerance) + "; expected a value in (0, 0.01]");
+  if (!(options.relative_tolerance >= 1e-8 && options.relative_tolerance <= 0.01))
+    throw Error("primitive tolerance " + num(options.relative_tolerance) + "; expected a value in [1e-8, 0.01]");
   check_primitive(p);
   // The arcs are built to half the tolerance: the cubic interpolant's radial error is sampled
   // (32 points per span), and the margin covers what falls between the samples.

@@ -131,8 +131,8 @@ ScenePrimitive read_primitive_cell(const Source& src, const json& cell, const st
   if (const json* t = find(cell["primitive"], "tolerance")) {
     const std::string tp = child(pp, "tolerance");
     const double tol = read_number(src, *t, tp);
-    if (!(tol > 0.0 && tol <= 0.01))
-      src.fail(tp, "tolerance " + format_double(tol) + "; expected a relative tolerance in (0, 0.01]");
+    if (!(tol >= 1e-8 && tol <= 0.01))
+      src.fail(tp, "tolerance " + format_double(tol) + "; expected a relative tolerance in [1e-8, 0.01]");
     out.options.relative_tolerance = tol;
   }
   if (const json* f = find(cell, "field")) {

@@ -103,7 +103,7 @@ TEST_CASE("scene: malformed scenes name the file, the place and what was expecte
   check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "cone", "base": [0, 0, 0], "axis": [0, 0, 1], "radius": 1, "top_radius": 0, "height": 1}, "field": {"constant": 1}})")),
                 {"s.json: /cells/0/primitive: cone top_radius 0", "expected a positive top_radius"});
   check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "tolerance": 0.5}, "field": {"constant": 1}})")),
-                {"s.json: /cells/0/primitive/tolerance: tolerance 0.5; expected a relative tolerance in (0, 0.01]"});
+                {"s.json: /cells/0/primitive/tolerance: tolerance 0.5; expected a relative tolerance in [1e-8, 0.01]"});
   check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}})")),
                 {"s.json: /cells/0: missing \"field\"; expected a property field"});
   check_message(read_error(scene(R"({"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {}})")),

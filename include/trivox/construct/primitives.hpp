@@ -106,7 +106,7 @@ struct PrimitiveCell {
 
 struct PrimitiveOptions {
   /// Largest distance of the boundary from the exact circle or sphere, relative to
-  /// characteristic_radius(). In (0, 0.01]. The default keeps the
+  /// characteristic_radius(). In [1e-8, 0.01] (finer would need thousands of spans). The default keeps the
   /// boundary within 2e-4 r (5 times inside the 1e-3 r the primitives promise) with 2-4 cubic
   /// spans per quarter circle; every halving of it costs about 1.2 times more spans per direction.
   double relative_tolerance = 2e-4;
