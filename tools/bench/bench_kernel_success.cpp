@@ -19,13 +19,12 @@
 // (seed, dataset, i), candidates are screened in parallel but kept in index order, and each
 // kept sample's runs are independent, so the table does not depend on the thread count.
 //
-// The paper does not say whether the inner control points are ordered along the curve; drawn
-// unordered, over 95% of the quartic and quadratic candidates self-intersect. By default they
-// are sorted along the curve's direction (x for bottom and top, y for left and right);
-// "unsorted" as the fifth argument draws them as they come.
+// The paper does not say whether the inner control points are ordered along the curve: by
+// default they are drawn as they come (the literal reading); "sorted" as the fifth argument
+// orders them along the curve's direction (x for bottom and top, y for left and right).
 //
 // Usage: trivox_bench_kernel_success [samples=1000] [threads=2] [seed=2023] [op|all]
-//                                    [sorted|unsorted] [cubic|quartic|quadratic|all]
+//                                    [unsorted|sorted] [cubic|quartic|quadratic|all]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -255,10 +254,10 @@ int main(int argc, char** argv) {
   const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
   const std::uint64_t seed = argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 2023;
   const std::string only = argc > 4 ? argv[4] : "";
-  const bool sorted = !(argc > 5 && std::string(argv[5]) == "unsorted");
+  const bool sorted = argc > 5 && std::string(argv[5]) == "sorted";
   const std::string only_kind = argc > 6 ? argv[6] : "all";
   if (samples < 1 || threads < 1) {
-    std::fprintf(stderr, "usage: %s [samples >= 1] [threads >= 1] [seed] [op|all] [sorted|unsorted] [cubic|quartic|quadratic|all]\n",
+    std::fprintf(stderr, "usage: %s [samples >= 1] [threads >= 1] [seed] [op|all] [unsorted|sorted] [cubic|quartic|quadratic|all]\n",
                  argv[0]);
     return 2;
   }
