@@ -322,9 +322,22 @@ std::vector<IntersectionPoint> march(const Solver& solver, const IntersectionPoi
 }
 
 /// Cubic interpolation of the points (chord length), closing the loop for closed curves.
-void fit_curves(IntersectionCurve& c) {
-  std::vector<IntersectionPoint> pts = c.points;
-  if (c.closed) pts.push_back(pts.front());
+void fit_curves(IntersectionCurve& c, double tol) {
+  // Points closer than the tolerance (a boundary end right after a step) would repeat a
+  // parameter: dropped, keeping the ends.
+  std::vector<IntersectionPoint> pts;
+  for (std::size_t i = 0; i < c.points.size(); ++i) {
+    if (!pts.empty() && dist(pts.back(), c.points[i]) <= 10 * tol) {
+      if (i + 1 == c.points.size() && pts.size() > 1) pts.back() = c.points[i];
+      continue;
+    }
+    pts.push_back(c.points[i]);
+  }
+  c.points = pts;
+  if (c.closed) {
+    if (pts.size() > 2 && dist(pts.back(), pts.front()) <= 10 * tol) pts.pop_back(), c.points.pop_back();
+    pts.push_back(pts.front());
+  }
   if (pts.size() < 2) return;
   std::vector<double> xyz, uv1, uv2;
   for (const auto& p : pts) {
@@ -333,11 +346,18 @@ void fit_curves(IntersectionCurve& c) {
     uv2.insert(uv2.end(), p.uv2.begin(), p.uv2.end());
   }
   const auto t = spline::chord_length_params(xyz, 3);
-  const int order = std::min<int>(4, static_cast<int>(pts.size()));
-  const auto kv = spline::interpolation_knots(t, order);
-  c.xyz = spline::interpolate_curve(t, 3, xyz, kv);
-  c.uv1 = spline::interpolate_curve(t, 2, uv1, kv);
-  c.uv2 = spline::interpolate_curve(t, 2, uv2, kv);
+  for (int order = std::min<int>(4, static_cast<int>(pts.size())); order >= 2; --order) {
+    try {
+      const auto kv = spline::interpolation_knots(t, order);
+      c.xyz = spline::interpolate_curve(t, 3, xyz, kv);
+      c.uv1 = spline::interpolate_curve(t, 2, uv1, kv);
+      c.uv2 = spline::interpolate_curve(t, 2, uv2, kv);
+      return;
+    } catch (const Error&) {
+      // Parameters too uneven for this order's averaged knots: one order lower (a polyline, order
+      // 2, always interpolates distinct parameters).
+    }
+  }
 }
 
 }  // namespace
@@ -362,6 +382,12 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
     for (const auto& c : out)
       if (polyline_distance(c.points, seed.xyz) < 0.75 * hmax) known = true;
     if (known) continue;
+    // Tangential contacts and coincident (overlapping) regions are not curves: skipped.
+    {
+      V3 T;
+      Eigen::Vector4d dt;
+      if (!solver.tangent(seed, T, dt)) continue;
+    }
     IntersectionCurve c;
     bool closed = false, closed_back = false;
     const auto fwd = march(solver, seed, 1.0, hmax, options.tolerance, closed);
@@ -373,7 +399,7 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
     c.closed = closed;
     // Densify until the xyz curve's midpoints lie on both surfaces.
     for (int pass = 0; pass < 6 && c.points.size() >= 2; ++pass) {
-      fit_curves(c);
+      fit_curves(c, options.tolerance);
       std::vector<IntersectionPoint> dense;
       bool all_good = true;
       const auto t = spline::chord_length_params(
@@ -407,7 +433,7 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
       if (all_good) break;
       c.points = std::move(dense);
     }
-    if (c.points.size() >= 2) fit_curves(c);
+    if (c.points.size() >= 2) fit_curves(c, options.tolerance);
     out.push_back(std::move(c));
   }
   return out;

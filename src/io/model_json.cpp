@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "json_io.hpp"
+#include "trivox/spline/extract.hpp"
 
 #include "trivox/error.hpp"
 
@@ -79,6 +80,26 @@ void read_trims(const Source& src, const json& item, const std::string& ip, cons
     cell.blend_power = read_number(src, *k, child(ip, "blend_power"));
     if (!(cell.blend_power > 0))
       src.fail(child(ip, "blend_power"), "power " + format_double(cell.blend_power) + "; expected a positive power");
+  }
+  if (const json* tc = find(item, "trim_curves")) {
+    const std::string tp = child(ip, "trim_curves");
+    const std::string what = "{\"face\": u0|u1|v0|v1|w0|w1, \"curves\": [curves in the face's parameters]}";
+    expect_array(src, *tc, tp, "an array of " + what);
+    for (std::size_t i = 0; i < tc->size(); ++i) {
+      const std::string fp = child(tp, i);
+      const json& f = expect_object(src, (*tc)[i], fp, what);
+      vmodel::FaceTrim t;
+      const std::string face = read_string(src, require(src, f, fp, "face", what), child(fp, "face"), "a face name u0 u1 v0 v1 w0 w1");
+      try {
+        t.face = spline::face_from_name(face);
+      } catch (const Error&) {
+        src.fail(child(fp, "face"), "unknown face " + quote(face) + "; expected u0, u1, v0, v1, w0 or w1");
+      }
+      const std::string cp = child(fp, "curves");
+      const json& cs = expect_array(src, require(src, f, fp, "curves", what), cp, "an array of curves {\"orders\", \"knots\", \"points\"} in R^2");
+      for (std::size_t k = 0; k < cs.size(); ++k) t.curves.push_back(read_spline<1>(src, cs[k], child(cp, k), PointShape{2, "2 (the face's parameters)"}));
+      cell.trim_curves.push_back(std::move(t));
+    }
   }
   if (const json* b = find(item, "boundaries")) {
     const std::string bp = child(ip, "boundaries");
@@ -170,6 +191,11 @@ void check_trims(const vmodel::VCell& c, const PointShape& shape) {
   if (!(c.blend_power > 0) || !std::isfinite(c.blend_power))
     throw Error(cannot_write + quote(c.name) + " has blend power " + format_double(c.blend_power) +
                 "; expected a positive power");
+  for (const auto& t : c.trim_curves)
+    for (const auto& k : t.curves)
+      if (k.dim() != 2)
+        throw Error(cannot_write + quote(c.name) + " has a trimming curve with " + plural(k.dim(), "coordinate") +
+                    "; expected 2 (the face's parameters)");
   for (const auto& list : c.boundaries)
     for (const auto& f : list) {
       if (f.dim() != 3)
@@ -231,6 +257,19 @@ void write_cell(std::string& out, const vmodel::VCell& c, const std::string& ind
   }
   if (c.blend != vmodel::BlendRule::first) out += ",\n" + in1 + "\"blend\": " + quote(vmodel::blend_rule_name(c.blend));
   if (c.blend_power != 1.0) out += ",\n" + in1 + "\"blend_power\": " + format_double(c.blend_power);
+  if (!c.trim_curves.empty()) {
+    out += ",\n" + in1 + "\"trim_curves\": [";
+    for (std::size_t i = 0; i < c.trim_curves.size(); ++i) {
+      out += (i ? ", " : "") + std::string("{\"face\": ") + quote(std::string(spline::face_name(c.trim_curves[i].face))) +
+             ", \"curves\": [";
+      for (std::size_t k = 0; k < c.trim_curves[i].curves.size(); ++k) {
+        out += (k ? ", " : "");
+        write_spline(out, c.trim_curves[i].curves[k], in1);
+      }
+      out += "]}";
+    }
+    out += "]";
+  }
   if (!c.boundaries.empty()) {
     out += ",\n" + in1 + "\"boundaries\": [";
     for (std::size_t i = 0; i < c.boundaries.size(); ++i) {

@@ -1,10 +1,12 @@
 #include "trivox/vmodel/boolean.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
 
 #include "trivox/error.hpp"
+#include "trivox/geom/surface_intersection.hpp"
 #include "trivox/spline/calculus.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/vmodel/topology.hpp"
@@ -75,6 +77,39 @@ std::vector<spline::Surface> boundary_of(const VModel& m) {
   return out;
 }
 
+/// Where the faces of `others` (those whose boxes meet home's) cut home's six faces: curves in
+/// each face's parameters (seed 003 Sec. 4: the trimming curves of the boundary V-surfaces).
+std::vector<FaceTrim> cut_faces(const VCell& home, const std::vector<VCell>& others, const std::vector<Box>& boxes,
+                                double tolerance) {
+  const Box hb = region_box(home);
+  std::vector<FaceTrim> out;
+  for (auto f : spline::all_faces) {
+    const spline::Surface S = spline::coordinates(spline::boundary_face(home.volume, f), 0, 3);
+    FaceTrim t;
+    t.face = f;
+    for (std::size_t j = 0; j < others.size(); ++j) {
+      if (!overlap(hb, boxes[j])) continue;
+      for (auto g : spline::all_faces) {
+        const spline::Surface G = spline::coordinates(spline::boundary_face(others[j].volume, g), 0, 3);
+        for (auto& c : geom::intersect_surfaces(S, G, {.tolerance = tolerance}))
+          if (c.points.size() >= 2) t.curves.push_back(std::move(c.uv1));
+      }
+    }
+    if (!t.curves.empty()) out.push_back(std::move(t));
+  }
+  return out;
+}
+
+double model_size(const VModel& a, const VModel& b) {
+  double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+  for (const auto* m : {&a, &b})
+    for (const auto& c : m->cells) {
+      const Box bx = region_box(c);
+      for (std::size_t d = 0; d < 3; ++d) lo[d] = std::min(lo[d], bx[0][d]), hi[d] = std::max(hi[d], bx[1][d]);
+    }
+  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
+
 class Names {
 public:
   std::string unique(const std::string& name) {
@@ -115,6 +150,21 @@ VModel boolean(const VModel& a, const VModel& b, BooleanOp op, const BooleanOpti
   out.surfaces = a.surfaces;
   out.surfaces.insert(out.surfaces.end(), b.surfaces.begin(), b.surfaces.end());
   Names names;
+  // Trimming curves of each input cell's faces by the other input (computed once per cell).
+  std::vector<std::vector<FaceTrim>> a_cuts(a.cells.size()), b_cuts(b.cells.size());
+  if (options.trim_curves) {
+    const double tol = 1e-9 * std::max(1e-300, model_size(a, b));
+    for (std::size_t i = 0; i < a.cells.size(); ++i) a_cuts[i] = cut_faces(a.cells[i], b.cells, b_boxes, tol);
+    if (op == BooleanOp::union_op)
+      for (std::size_t j = 0; j < b.cells.size(); ++j) b_cuts[j] = cut_faces(b.cells[j], a.cells, a_boxes, tol);
+  }
+  const auto add_cuts = [](VCell& c, const std::vector<FaceTrim>& cuts) {
+    for (const auto& t : cuts) {
+      auto it = std::find_if(c.trim_curves.begin(), c.trim_curves.end(), [&](const FaceTrim& x) { return x.face == t.face; });
+      if (it == c.trim_curves.end()) c.trim_curves.push_back(t);
+      else it->curves.insert(it->curves.end(), t.curves.begin(), t.curves.end());
+    }
+  };
   // Alg. 1: every pair of cells whose boxes meet; the first input's trivariate carries the
   // geometry, the second rides along in `within`.
   if (op != BooleanOp::subtraction)
@@ -133,19 +183,22 @@ VModel boolean(const VModel& a, const VModel& b, BooleanOp op, const BooleanOpti
         }
         c.within.push_back(b.cells[j]);
         c.blend = options.blend;
+        add_cuts(c, a_cuts[i]);
         out.cells.push_back(std::move(c));
       }
   // Alg. 2: A - B (and, for the union, B - A), each cell minus the whole other model.
   if (op != BooleanOp::intersection)
-    for (const auto& c : a.cells) {
-      VCell d = minus(c, b.cells, b_boxes);
-      d.name = names.unique(c.name);
+    for (std::size_t i = 0; i < a.cells.size(); ++i) {
+      VCell d = minus(a.cells[i], b.cells, b_boxes);
+      d.name = names.unique(a.cells[i].name);
+      add_cuts(d, a_cuts[i]);
       out.cells.push_back(std::move(d));
     }
   if (op == BooleanOp::union_op)
-    for (const auto& c : b.cells) {
-      VCell d = minus(c, a.cells, a_boxes);
-      d.name = names.unique(c.name);
+    for (std::size_t j = 0; j < b.cells.size(); ++j) {
+      VCell d = minus(b.cells[j], a.cells, a_boxes);
+      d.name = names.unique(b.cells[j].name);
+      add_cuts(d, b_cuts[j]);
       out.cells.push_back(std::move(d));
     }
   return out;

@@ -232,6 +232,22 @@ TEST_CASE("seed 003 Fig. 3: two boxes united give three box cells with the state
     const slice::Locator loc(U, {.tolerance = 1e-9});
     for (int c = 0; c < 3; ++c) CHECK(slice::trimmed_volume(loc, c) == Approx(1.0).epsilon(1e-12));
   }
+  // Trimming curves: O2's face x = 1 cuts O1's front face (v0, parameters (u, w)) along u = 1/2;
+  // O1's top z = 1 cuts O2's face u0 (parameters (v, w)) along w = 1/2.
+  const auto has_line = [](const vmodel::VCell& c, spline::Face f, int coord, double value) {
+    for (const auto& t : c.trim_curves) {
+      if (t.face != f) continue;
+      for (const auto& k : t.curves) {
+        bool on = true;
+        for (int i = 0; i <= 20; ++i) on = on && std::abs(k.eval({k.domain(0)[0] + i * (k.domain(0)[1] - k.domain(0)[0]) / 20})[coord] - value) < 1e-9;
+        if (on) return true;
+      }
+    }
+    return false;
+  };
+  CHECK(has_line(U.cells[0], spline::Face::v0, 0, 0.5));
+  CHECK(has_line(U.cells[1], spline::Face::v0, 0, 0.5));
+  CHECK(has_line(U.cells[2], spline::Face::u0, 1, 0.5));
   const VModel T = slice::untrim(U);
   REQUIRE(T.cells.size() == 3);
   const auto n = vmodel::counts(vmodel::build_topology(T));

@@ -20,8 +20,8 @@
 ///    space; the points are densified until the xyz curve's midpoints lie within the tolerance of
 ///    both surfaces.
 /// Points meet the surfaces to `tolerance` (absolute, model units). Tangential contacts (where
-/// n_1 x n_2 vanishes) are not traced: they are reported as isolated points when a seed
-/// converges there. Cost: seeds O(pairs of pieces * subdivisions), tracing O(length / step)
+/// n_1 x n_2 vanishes) and coincident regions (coplanar faces) are not curves and are not
+/// reported. Cost: seeds O(pairs of pieces * subdivisions), tracing O(length / step)
 /// Newton solves of a few evaluations each.
 #pragma once
 #include <array>

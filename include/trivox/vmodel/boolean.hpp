@@ -18,7 +18,12 @@
 /// (vmodel/topology.hpp); for an input that is itself trimmed these are its trivariates' free
 /// faces, an approximation of its true boundary.
 ///
-/// Cost: O(|A| * |B|) box tests; the result holds copies of the trivariates it refers to.
+/// Trimming curves: each piece's faces carry the curves where the other input's cells' faces cut
+/// them (VCell::trim_curves, in the face's parameters), as the boundary V-surfaces of the paper
+/// carry trimming curves; membership does not depend on them.
+///
+/// Cost: O(|A| * |B|) box tests, and 36 surface intersections per pair of cells whose boxes
+/// meet (when trim_curves); the result holds copies of the trivariates it refers to.
 #pragma once
 #include <string>
 
@@ -39,6 +44,9 @@ struct BooleanOptions {
   /// Names of the result's cells: intersection cells are "<a><join><b>"; cells of A - B and
   /// B - A keep their names. Repeated names get a suffix ".2", ".3", ...
   std::string join = "&";
+  /// Compute the trimming curves (VCell::trim_curves): where the other input's cell faces cut
+  /// each piece's faces, by surface-surface intersection (geom/surface_intersection.hpp).
+  bool trim_curves = true;
 };
 
 /// The Boolean operation `op` of models a and b (same property names in the same order, same

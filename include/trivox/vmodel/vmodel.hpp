@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "trivox/spline/extract.hpp"
 #include "trivox/spline/tensor_spline.hpp"
 
 namespace trivox::vmodel {
@@ -34,6 +35,16 @@ enum class BlendRule {
 const char* blend_rule_name(BlendRule r) noexcept;
 /// The rule called `name`, or false.
 bool blend_rule_from_name(std::string_view name, BlendRule& out) noexcept;
+
+/// Trimming curves on one boundary face of a cell's trivariate: where the other input of a
+/// Boolean cuts that face (surface-surface intersection, seed 003 Sec. 4), as curves in the
+/// face's parameter space (R^2; the face's parameters are the two other directions in order).
+struct FaceTrim {
+  spline::Face face = spline::Face::u0;
+  std::vector<spline::Curve> curves;
+
+  bool operator==(const FaceTrim&) const = default;
+};
 
 /// One volumetric cell: a trivariate in R^(3+m), coordinates 0..2 xyz and 3.. the properties.
 ///
@@ -59,6 +70,8 @@ struct VCell {
   /// BlendRule::distance: one list of boundary surfaces (xyz) per blended value: the input
   /// model that `volume` came from, then that of each within cell.
   std::vector<std::vector<spline::Surface>> boundaries;
+  /// Booleans: where the other input's faces cut this cell's faces (per face, in order).
+  std::vector<FaceTrim> trim_curves;
 
   /// No trimming: the cell is its trivariate's image.
   bool plain() const noexcept { return within.empty() && without.empty(); }
