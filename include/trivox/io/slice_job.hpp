@@ -68,7 +68,7 @@ struct SliceJobSummary {
   double voxel_volume_mm3 = 0.0;
   std::string mapping;                   ///< how properties drive materials
   std::filesystem::path zip_file;        ///< set when zip was asked for
-  /// Thread-seconds spent per stage, summed over workers: sample (locate + evaluate), map
+  /// Thread-seconds (CPU time of the worker threads) spent per stage, summed over workers: sample (locate + evaluate), map
   /// (properties to fractions), dither, paint (material indices to RGBA and counts), encode (PNG
   /// and its SHA-256). Map, dither and paint run as one pass per row
   /// (slice::LayerDitherer::dither_paint), timed together under dither; map and paint stay 0.
