@@ -5,6 +5,8 @@
 // cell is not valid (the model is written all the same, so it can be inspected).
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -14,6 +16,8 @@
 #include "trivox/geom/validity.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/scene.hpp"
+#include "trivox/slice/locator.hpp"
+#include "trivox/slice/trim.hpp"
 
 namespace trivox::cli {
 
@@ -23,6 +27,11 @@ struct Options {
   std::string scene, output;
   bool force = false;
 };
+
+double extent(const vmodel::VModel& m) {
+  const auto b = slice::model_bounds(m);
+  return std::hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]);
+}
 
 struct CellQuality {
   bool checked = false;  ///< false for a rational trivariate, which check_validity does not decide
@@ -140,6 +149,15 @@ void add_build(CLI::App& app, Common& common) {
       if (q[i].checked) q[i].validity = geom::check_validity(*geometry[i]);
       q[i].volume = geom::volume(*geometry[i]);
     });
+    // Pieces of Booleans: the volume of the part their trimming admits (slice/trim.hpp).
+    bool trimmed = false;
+    for (const auto& c : built.model.cells) trimmed = trimmed || !c.plain();
+    if (trimmed) {
+      const slice::Locator loc(built.model, {.tolerance = 1e-9 * std::max(1e-300, extent(built.model))});
+      tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
+        if (!built.model.cells[i].plain()) q[i].volume = slice::trimmed_volume(loc, static_cast<int>(i));
+      });
+    }
     io::save_model(built.model, opt->output);
     const auto j = report(built, q, *opt);
     if (common.json)

@@ -1,11 +1,14 @@
 #include "trivox/io/scene.hpp"
 
+#include <algorithm>
 #include <map>
 
 #include "json_io.hpp"
 
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/slice/trim.hpp"
+#include "trivox/vmodel/boolean.hpp"
 
 namespace trivox::io {
 
@@ -210,9 +213,112 @@ std::vector<SceneOperation> read_operations(const Source& src, const json& root)
     bool known = false;
     for (const char* k : scene_operations) known = known || op == k;
     if (!known) src.fail(op_ptr, "unknown operation " + quote(op) + "; expected one of " + known_operations());
-    out.push_back({op, ip});
+    SceneOperation o;
+    o.op = op;
+    o.pointer = ip;
+    if (op == "union" || op == "intersection" || op == "subtraction") {
+      const std::string bwhat = "a Boolean {\"op\", \"a\": NAME, \"b\": NAME, \"name\", \"blend\", \"power\"}";
+      o.a = read_string(src, require(src, item, ip, "a", bwhat), child(ip, "a"), "the name of a cell or earlier result");
+      o.b = read_string(src, require(src, item, ip, "b", bwhat), child(ip, "b"), "the name of a cell or earlier result");
+      o.name = o.a;
+      if (const json* n = find(item, "name")) {
+        o.name = read_string(src, *n, child(ip, "name"), "a non-empty result name");
+        if (o.name.empty()) src.fail(child(ip, "name"), "empty name; expected a non-empty result name");
+      }
+      if (const json* bl = find(item, "blend")) {
+        const std::string expected = "a blend rule: \"sum_clip\", \"mean\", \"first\" or \"distance\"";
+        const std::string rule = read_string(src, *bl, child(ip, "blend"), expected);
+        if (!vmodel::blend_rule_from_name(rule, o.blend))
+          src.fail(child(ip, "blend"), "unknown blend rule " + quote(rule) + "; expected " + expected);
+      }
+      if (const json* pw = find(item, "power")) {
+        o.power = read_number(src, *pw, child(ip, "power"));
+        if (!(o.power > 0 && o.power <= 64))
+          src.fail(child(ip, "power"), "power " + format_double(o.power) + "; expected a power in (0, 64]");
+      }
+    }
+    out.push_back(std::move(o));
   }
   return out;
+}
+
+/// The scene's Boolean operations, in order, on named objects: each scene cell (a primitive's
+/// cells together) is an object; an operation replaces its operands by its result, placed where
+/// `a` was. The primitives' reports keep only the primitives no operation consumed.
+void apply_booleans(const Scene& scene, const Source& src, SceneBuild& out) {
+  struct Object {
+    std::string name;
+    std::vector<vmodel::VCell> cells;
+    int primitive = -1;  ///< index into out.primitives, -1 for a result or a trivariate cell
+  };
+  std::vector<Object> objects;
+  std::size_t next = 0;
+  for (const SceneCell& cell : scene.cells) {
+    Object o;
+    o.name = cell.name;
+    int count = 1;
+    for (std::size_t p = 0; p < out.primitives.size(); ++p)
+      if (out.primitives[p].name == cell.name) {
+        o.primitive = static_cast<int>(p);
+        count = out.primitives[p].cell_count;
+      }
+    for (int k = 0; k < count; ++k) o.cells.push_back(std::move(out.model.cells[next++]));
+    objects.push_back(std::move(o));
+  }
+  const auto find_object = [&](const std::string& name) {
+    return std::find_if(objects.begin(), objects.end(), [&](const Object& o) { return o.name == name; });
+  };
+  for (const SceneOperation& op : scene.operations) {
+    const auto ia = find_object(op.a);
+    if (ia == objects.end())
+      src.fail(op.pointer + "/a", "no cell or result named " + quote(op.a) + "; expected the name of a scene cell or of an earlier operation's result");
+    const auto ib = find_object(op.b);
+    if (ib == objects.end())
+      src.fail(op.pointer + "/b", "no cell or result named " + quote(op.b) + "; expected the name of a scene cell or of an earlier operation's result");
+    if (ia == ib) src.fail(op.pointer + "/b", quote(op.b) + " is also \"a\"; expected two different operands");
+    if (op.name != op.a && op.name != op.b && find_object(op.name) != objects.end())
+      src.fail(op.pointer + "/name", quote(op.name) + " names another cell or result; expected a fresh name");
+    vmodel::VModel A, B;
+    A.units = B.units = scene.units;
+    A.properties = B.properties = scene.properties;
+    A.cells = ia->cells;
+    B.cells = ib->cells;
+    const vmodel::BooleanOp kind = op.op == "union" ? vmodel::BooleanOp::union_op
+                                   : op.op == "intersection" ? vmodel::BooleanOp::intersection
+                                                             : vmodel::BooleanOp::subtraction;
+    vmodel::VModel r;
+    try {
+      r = slice::untrim(vmodel::boolean(A, B, kind, {.blend = op.blend, .power = op.power}));
+    } catch (const Error& e) {
+      throw e.within(src.at(op.pointer));
+    }
+    if (r.cells.empty())
+      src.fail(op.pointer, "the " + op.op + " of " + quote(op.a) + " and " + quote(op.b) +
+                               " is empty (their boxes do not meet); expected operands that overlap");
+    Object result{op.name, std::move(r.cells), -1};
+    const std::size_t at = static_cast<std::size_t>(ia - objects.begin());
+    const std::size_t bt = static_cast<std::size_t>(ib - objects.begin());
+    objects[at] = std::move(result);
+    objects.erase(objects.begin() + static_cast<std::ptrdiff_t>(bt));
+  }
+  // The model: the remaining objects in order; reports for the untouched primitives.
+  std::vector<PrimitiveBuild> kept;
+  out.model.cells.clear();
+  std::map<std::string, std::string> names;
+  for (auto& o : objects) {
+    if (o.primitive >= 0) {
+      PrimitiveBuild rep = std::move(out.primitives[static_cast<std::size_t>(o.primitive)]);
+      rep.first_cell = static_cast<int>(out.model.cells.size());
+      kept.push_back(std::move(rep));
+    }
+    for (auto& c : o.cells) {
+      if (!names.emplace(c.name, o.name).second)
+        src.fail("/operations", "the result has two cells named " + quote(c.name) + "; expected distinct cell names "
+                                "(rename a scene cell)");
+      out.model.cells.push_back(std::move(c));
+    }
+  }
+  out.primitives = std::move(kept);
 }
 
 }  // namespace
@@ -240,14 +346,14 @@ Scene load_scene(const std::filesystem::path& path) { return read_scene_json(rea
 
 SceneBuild build_scene(const Scene& scene) {
   const Source src{scene.source};
-  if (!scene.operations.empty()) {
-    const SceneOperation& op = scene.operations.front();
+  for (const SceneOperation& op : scene.operations) {
     const bool boolean = op.op == "union" || op.op == "intersection" || op.op == "subtraction";
+    if (boolean) continue;
     src.fail(op.pointer + "/op",
              quote(op.op) + " is not supported yet (" +
-                 (boolean ? std::string("Booleans of V-models") : op.op == "fillet" ? "trivariate fillets" : "constructor operations in scenes") +
-                 " are later work; `trivox construct` runs one constructor on its own); expected a scene whose "
-                 "\"operations\" list is empty");
+                 (op.op == "fillet" ? std::string("trivariate fillets") : std::string("constructor operations in scenes")) +
+                 " are later work; `trivox construct` runs one constructor on its own); expected union, "
+                 "intersection or subtraction");
   }
   SceneBuild out;
   out.model.units = scene.units;
@@ -289,6 +395,7 @@ SceneBuild build_scene(const Scene& scene) {
     }
     out.primitives.push_back(std::move(report));
   }
+  if (!scene.operations.empty()) apply_booleans(scene, src, out);
   return out;
 }
 

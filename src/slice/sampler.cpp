@@ -1,5 +1,7 @@
 #include "trivox/slice/sampler.hpp"
 
+#include "trivox/slice/trim.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -746,6 +748,9 @@ void LayerSampler::sample(int layer, int row0, int rows, RowBand& out) const {
       out.inverted += blk.inverted[src];
     }
   }
+  // Cells of Booleans: the first cell whose trivariate holds a voxel took it above; the trimming
+  // pass gives it to the cell whose conditions admit it (or to none) and blends properties.
+  if (locator_.has_trims()) apply_trimming(locator_, grid_, out);
 }
 
 }  // namespace trivox::slice

@@ -12,8 +12,12 @@
 ///
 /// Operations: the names of DESIGN.md (`union`, `intersection`, `subtraction`, `fillet` and the
 /// constructors `ruled`, `extrude`, `revolve`, `boolean_sum`, `half_boolean_sum`, `sweep`) are
-/// recognised; building them is later work, so build_scene refuses a scene with any operation,
-/// naming it ("not supported yet"). An unknown name is refused by the reader, which lists the
+/// recognised. The Booleans are built (vmodel/boolean.hpp: seed 003 Alg. 1-3): {"op": "union",
+/// "a": NAME, "b": NAME, "name": RESULT (default: a), "blend": "sum_clip" | "mean" | "first" |
+/// "distance", "power": k}, where a and b name scene cells (a primitive's cells all together) or
+/// earlier results; the operation consumes a and b and puts its result, untrimmed
+/// (slice::untrim), where a was. The other operations are later work: build_scene refuses them,
+/// naming them ("not supported yet"). An unknown name is refused by the reader, which lists the
 /// known ones.
 ///
 /// Cost: linear in the file size to read; building is the primitives' cost (milliseconds each)
@@ -52,6 +56,11 @@ struct SceneCell {
 struct SceneOperation {
   std::string op;
   std::string pointer;  ///< "/operations/<i>"
+  // Booleans:
+  std::string a, b;     ///< the operands: scene cell names or earlier results
+  std::string name;     ///< the result's name (a when not given)
+  vmodel::BlendRule blend = vmodel::BlendRule::sum_clip;
+  double power = 1.0;
 };
 
 struct Scene {

@@ -38,6 +38,10 @@
 /// half the smallest pitch for certified ones (their exact preimage being within the certified
 /// radius).
 ///
+/// Booleans: for a model with trimmed cells (vmodel/boolean.hpp), each sampled band then goes
+/// through slice/trim.hpp's apply_trimming, so occupancy and properties follow the trimming
+/// exactly (one point location per condition for each voxel of a trimmed cell).
+///
 /// Determinism: a block's result depends only on the block (layer and its 4 image rows); a band
 /// computes every block it touches in full and copies out its rows, so any banding and thread
 /// count give identical output.
