@@ -13,9 +13,12 @@
 #include "trivox/construct/kernel_construct.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/planar_crossing.hpp"
+#include "trivox/geom/surface_intersection.hpp"
 #include "trivox/geom/validity.hpp"
 #include "trivox/io/construct_file.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/spline/calculus.hpp"
+#include "trivox/spline/extract.hpp"
 
 namespace trivox::cli {
 
@@ -89,6 +92,35 @@ void check_simple(const io::ConstructInput& in, const std::string& file) {
                 "; expected curves free of self-intersections");
   throw Error(file + ": /curves/" + std::to_string(x->curve_a) + " and /curves/" + std::to_string(x->curve_b) +
               " cross " + where + "; expected boundary curves that meet only at their shared ends");
+}
+
+/// Input surfaces of a trivariate constructor may meet only along their boundaries (shared
+/// edges): any intersection point inside both (surface-surface intersection) is a crossing.
+void check_surfaces_apart(const io::ConstructInput& in, const std::string& file) {
+  if (in.surfaces.size() < 2 || in.op == "sweep" || in.op == "extrude" || in.op == "revolve") return;
+  std::vector<spline::Surface> xyz;
+  for (const auto& s : in.surfaces) xyz.push_back(s.dim() > 3 ? spline::coordinates(s, 0, 3) : s);
+  const auto interior = [](const spline::Surface& s, const std::array<double, 2>& t) {
+    for (int d = 0; d < 2; ++d) {
+      const auto dom = s.domain(d);
+      const double w = 1e-6 * (dom[1] - dom[0]);
+      if (t[static_cast<std::size_t>(d)] <= dom[0] + w || t[static_cast<std::size_t>(d)] >= dom[1] - w) return false;
+    }
+    return true;
+  };
+  double size = 0.0;
+  for (const auto& s : xyz) {
+    const auto b = spline::bounding_box(s, 3);
+    size = std::max(size, std::hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]));
+  }
+  for (std::size_t i = 0; i < xyz.size(); ++i)
+    for (std::size_t j = i + 1; j < xyz.size(); ++j)
+      for (const auto& c : geom::intersect_surfaces(xyz[i], xyz[j], {.tolerance = 1e-9 * std::max(size, 1e-300)}))
+        for (const auto& p : c.points)
+          if (interior(xyz[i], p.uv1) && interior(xyz[j], p.uv2))
+            throw Error(file + ": /surfaces/" + std::to_string(i) + " and /surfaces/" + std::to_string(j) + " cross near (" +
+                        fmt(p.xyz[0], 8) + ", " + fmt(p.xyz[1], 8) + ", " + fmt(p.xyz[2], 8) +
+                        "); expected surfaces that meet only along their shared boundaries");
 }
 
 template <int P>
@@ -260,6 +292,7 @@ void add_construct(CLI::App& app, Common& common) {
       throw Error(opt->output + ": the output file exists; expected a new path (or --force to overwrite)");
     const io::ConstructInput in = io::read_construct_input(io::read_file(opt->input), opt->input);
     check_simple(in, opt->input);
+    check_surfaces_apart(in, opt->input);
     if (!in.curves.empty()) run<2>(*opt, in, common);
     else run<3>(*opt, in, common);
   });

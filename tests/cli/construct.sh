@@ -55,6 +55,13 @@ json.dump({"trivox": 1, "op": "extrude", "curves": [line([0, 0], [3, 0])], "vect
 json.dump({"trivox": 1, "op": "boolean_sum",
            "curves": [line([0, 0], [1, 0]), line([0, 1], [1, 1]), line([0, 0], [0, 1]), poly([[1, 0], [-0.5, 0.5], [1, 1]])]},
           open(d + "/crossing.json", "w"))
+# A box whose top face (w1) dips through its bottom face (w0): the two cross inside both.
+faces = [face(k, v) for k in range(3) for v in (0, 1)]
+top = faces[5]
+top["orders"] = [3, 3]
+top["knots"] = [[0, 0, 0, 1, 1, 1], [0, 0, 0, 1, 1, 1]]
+top["points"] = [[a * 0.5, b * 1.0, (-20.0 if (a, b) == (1, 1) else 3.0)] for b in range(3) for a in range(3)]
+json.dump({"trivox": 1, "op": "boolean_sum", "surfaces": faces}, open(d + "/dip.json", "w"))
 json.dump({"trivox": 1, "op": "pizza", "curves": []}, open(d + "/badop.json", "w"))
 json.dump({"trivox": 1, "op": "ruled", "curves": [line([0, 0], [1, 0])]}, open(d + "/fewer.json", "w"))
 json.dump({"trivox": 1, "op": "boolean_sum",
@@ -160,6 +167,7 @@ expect_fail '/curves: 1 curve for "ruled"; expected 2 curves' "$trivox" construc
 expect_fail 'bottom(1) and right(0) are 0.5 apart' "$trivox" construct "$tmp/gap.json"
 expect_fail '/curves/1/points/0: 3 coordinates; expected 2 (as in /curves/0)' "$trivox" construct "$tmp/dims.json"
 expect_fail '/curves/2 and /curves/3 cross near (0, 0.3333' "$trivox" construct "$tmp/crossing.json"
+expect_fail '/surfaces/4 and /surfaces/5 cross near' "$trivox" construct "$tmp/dip.json"
 expect_fail 'no such file' "$trivox" construct "$tmp/missing.json"
 echo '{"trivox": 1, "op": "ruled", "curves": [' > "$tmp/broken.json"
 expect_fail 'malformed JSON' "$trivox" construct "$tmp/broken.json"
