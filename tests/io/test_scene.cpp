@@ -126,8 +126,9 @@ TEST_CASE("scene: malformed scenes name the file, the place and what was expecte
                  "\"subtraction\", \"fillet\", \"ruled\", \"extrude\", \"revolve\", \"boolean_sum\", \"half_boolean_sum\", \"sweep\""});
 }
 
-TEST_CASE("scene: operations are not built yet; expanded names must stay unique", "[scene]") {
-  for (const char* op : io::scene_operations) {
+TEST_CASE("scene: fillets and constructor operations are not built yet; expanded names must stay unique", "[scene]") {
+  // union, intersection and subtraction are built (tests/cli/booleans.sh); the others not yet.
+  for (const char* op : {"fillet", "ruled", "extrude", "revolve", "boolean_sum", "half_boolean_sum", "sweep"}) {
     INFO(op);
     check_message(build_error(scene(ball, std::string(R"({"op": ")") + op + "\"}")),
                   {"s.json: /operations/0/op: \"" + std::string(op) + "\" is not supported yet", "expected"});
