@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 
 #include "trivox/error.hpp"
@@ -440,12 +441,26 @@ Trivariate boolean_sum(std::span<const Surface> faces_in, const MatchOptions& ma
   return spline::add(T, Puvw);
 }
 
+namespace {
+
+/// The inputs of a constructor, checked (same coordinates, polynomial) and normalized().
+template <int P>
+std::vector<TensorSpline<P>> prepared(std::initializer_list<TensorSpline<P>> in, const char* what) {
+  const std::vector<TensorSpline<P>> all(in);
+  require_same_dim<P>(all, what);
+  std::vector<TensorSpline<P>> out;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    require_polynomial(all[i], std::string(what) + " " + std::to_string(i));
+    out.push_back(normalized(all[i]));
+  }
+  return out;
+}
+
+}  // namespace
+
 Surface half_boolean_sum(const Curve& c1_in, const Curve& c2_in, const MatchOptions& match) {
-  const Curve all[2] = {c1_in, c2_in};
-  require_same_dim<1>(all, "curve");
-  require_polynomial(c1_in, "curve 0");
-  require_polynomial(c2_in, "curve 1");
-  const Curve c1 = normalized(c1_in), c2 = normalized(c2_in);
+  const auto in = prepared<1>({c1_in, c2_in}, "curve");
+  const Curve &c1 = in[0], &c2 = in[1];
   const auto p1 = c1.eval({0.0}), p2 = c2.eval({0.0});
   check_points_match(p1, p2, match, "curve 0 at its start", "curve 1 at its start");
   std::vector<double> P(p1.size());
@@ -455,11 +470,8 @@ Surface half_boolean_sum(const Curve& c1_in, const Curve& c2_in, const MatchOpti
 }
 
 Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const MatchOptions& match) {
-  const Surface all[2] = {s1_in, s2_in};
-  require_same_dim<2>(all, "surface");
-  require_polynomial(s1_in, "surface 0");
-  require_polynomial(s2_in, "surface 1");
-  const Surface s1 = normalized(s1_in), s2 = normalized(s2_in);
+  const auto in = prepared<2>({s1_in, s2_in}, "surface");
+  const Surface &s1 = in[0], &s2 = in[1];
   const Curve a = spline::iso(s1, 1, 0.0), b = spline::iso(s2, 1, 0.0);
   check_curves_match(a, b, match, "surface 0 at v = 0", "surface 1 at w = 0", "u");
   const Curve C = average(a, b);
@@ -470,10 +482,8 @@ Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const Ma
 
 Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const Surface& s3_in,
                             const MatchOptions& match) {
-  const Surface all[3] = {s1_in, s2_in, s3_in};
-  require_same_dim<2>(all, "surface");
-  for (int i = 0; i < 3; ++i) require_polynomial(all[i], "surface " + std::to_string(i));
-  const Surface s1 = normalized(s1_in), s2 = normalized(s2_in), s3 = normalized(s3_in);
+  const auto in = prepared<2>({s1_in, s2_in, s3_in}, "surface");
+  const Surface &s1 = in[0], &s2 = in[1], &s3 = in[2];
   // C1(u) = s1(u, 0) = s3(u, 0); C2(v) = s1(0, v) = s2(v, 0); C3(w) = s2(0, w) = s3(0, w).
   const Curve a1 = spline::iso(s1, 1, 0.0), b1 = spline::iso(s3, 1, 0.0);
   const Curve a2 = spline::iso(s1, 0, 0.0), b2 = spline::iso(s2, 1, 0.0);

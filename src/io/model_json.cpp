@@ -230,57 +230,45 @@ void check_writable(const vmodel::VModel& m) {
   for (const auto& s : m.surfaces) check_item(s.name, s.surface, shape, names);
 }
 
+/// "[x0, x1, ...]" with each element written by `write`.
+template <class Items, class Write>
+void write_list(std::string& out, const Items& items, Write write) {
+  out += '[';
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i) out += ", ";
+    write(items[i]);
+  }
+  out += ']';
+}
+
 /// A cell object at the given indentation, with its trimming (nested cells) when it has any.
 void write_cell(std::string& out, const vmodel::VCell& c, const std::string& indent) {
   const std::string in1 = indent + "  ";
+  const auto cell = [&](const vmodel::VCell& x) { write_cell(out, x, in1); };
+  const auto spline = [&](const auto& x) { write_spline(out, x, in1); };
   out += "{\n" + in1 + "\"name\": " + quote(c.name) + ",\n" + in1 + "\"trivariate\": ";
   write_spline(out, c.volume, in1);
   if (!c.within.empty()) {
-    out += ",\n" + in1 + "\"within\": [";
-    for (std::size_t i = 0; i < c.within.size(); ++i) {
-      out += (i ? ", " : "");
-      write_cell(out, c.within[i], in1);
-    }
-    out += "]";
+    out += ",\n" + in1 + "\"within\": ";
+    write_list(out, c.within, cell);
   }
   if (!c.without.empty()) {
-    out += ",\n" + in1 + "\"without\": [";
-    for (std::size_t i = 0; i < c.without.size(); ++i) {
-      out += (i ? ", [" : "[");
-      for (std::size_t k = 0; k < c.without[i].size(); ++k) {
-        out += (k ? ", " : "");
-        write_cell(out, c.without[i][k], in1);
-      }
-      out += "]";
-    }
-    out += "]";
+    out += ",\n" + in1 + "\"without\": ";
+    write_list(out, c.without, [&](const std::vector<vmodel::VCell>& solid) { write_list(out, solid, cell); });
   }
   if (c.blend != vmodel::BlendRule::first) out += ",\n" + in1 + "\"blend\": " + quote(vmodel::blend_rule_name(c.blend));
   if (c.blend_power != 1.0) out += ",\n" + in1 + "\"blend_power\": " + format_double(c.blend_power);
   if (!c.trim_curves.empty()) {
-    out += ",\n" + in1 + "\"trim_curves\": [";
-    for (std::size_t i = 0; i < c.trim_curves.size(); ++i) {
-      out += (i ? ", " : "") + std::string("{\"face\": ") + quote(std::string(spline::face_name(c.trim_curves[i].face))) +
-             ", \"curves\": [";
-      for (std::size_t k = 0; k < c.trim_curves[i].curves.size(); ++k) {
-        out += (k ? ", " : "");
-        write_spline(out, c.trim_curves[i].curves[k], in1);
-      }
-      out += "]}";
-    }
-    out += "]";
+    out += ",\n" + in1 + "\"trim_curves\": ";
+    write_list(out, c.trim_curves, [&](const vmodel::FaceTrim& t) {
+      out += "{\"face\": " + quote(std::string(spline::face_name(t.face))) + ", \"curves\": ";
+      write_list(out, t.curves, spline);
+      out += "}";
+    });
   }
   if (!c.boundaries.empty()) {
-    out += ",\n" + in1 + "\"boundaries\": [";
-    for (std::size_t i = 0; i < c.boundaries.size(); ++i) {
-      out += (i ? ", [" : "[");
-      for (std::size_t k = 0; k < c.boundaries[i].size(); ++k) {
-        out += (k ? ", " : "");
-        write_spline(out, c.boundaries[i][k], in1);
-      }
-      out += "]";
-    }
-    out += "]";
+    out += ",\n" + in1 + "\"boundaries\": ";
+    write_list(out, c.boundaries, [&](const std::vector<spline::Surface>& list) { write_list(out, list, spline); });
   }
   out += "\n" + indent + "}";
 }

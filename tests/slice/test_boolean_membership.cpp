@@ -37,6 +37,21 @@ VModel box(const std::string& name, std::array<double, 3> lo, std::array<double,
   return m;
 }
 
+/// The ring 1 <= r <= 2, 0 <= z <= 1 about z, property 0.1: a rectangle revolved within
+/// `tolerance` (relative) of the exact circle.
+VModel ring_model(double tolerance) {
+  std::vector<double> rect;
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) rect.insert(rect.end(), {1.0 + i, 0.0, double(j), 0.1});
+  const spline::Surface profile({KnotVector::bezier(2), KnotVector::bezier(2)}, 4, rect);
+  construct::Revolution rev;
+  rev.relative_tolerance = tolerance;
+  VModel ring;
+  ring.properties = {"r"};
+  ring.cells.push_back({"ring", construct::revolve(profile, rev)});
+  return ring;
+}
+
 bool in_box(const slice::Vec3& p, std::array<double, 3> lo, std::array<double, 3> hi) {
   for (std::size_t d = 0; d < 3; ++d)
     if (p[d] < lo[d] || p[d] > hi[d]) return false;
@@ -134,15 +149,7 @@ TEST_CASE("nested Booleans with a curved cell keep exact membership", "[boolean]
   // A ring 1 <= r <= 2, 0 <= z <= 1 (revolution within 1e-6 of the exact circle, below the 1e-4 margin), a box
   // cutting it, and a second box subtracted from the result, then that result subtracted from
   // a third box: C - ((ring u box1) - box2).
-  std::vector<double> rect;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) rect.insert(rect.end(), {1.0 + i, 0.0, double(j), 0.1});
-  const spline::Surface profile({KnotVector::bezier(2), KnotVector::bezier(2)}, 4, rect);
-  construct::Revolution rev;
-  rev.relative_tolerance = 1e-6;
-  VModel ring;
-  ring.properties = {"r"};
-  ring.cells.push_back({"ring", construct::revolve(profile, rev)});
+  const VModel ring = ring_model(1e-6);
   const std::array<double, 3> b10{-0.5, -0.5, -0.5}, b11{0.5, 2.5, 1.5};
   const std::array<double, 3> b20{1.2, -3, 0.5}, b21{3, 3, 2};
   const std::array<double, 3> c0{-2.5, -0.25, 0.25}, c1{2.5, 0.25, 0.75};
@@ -268,15 +275,7 @@ TEST_CASE("seed 003 Fig. 3: two boxes united give three box cells with the state
 TEST_CASE("the volume of a curved trimmed cell is close to the analytic one", "[boolean]") {
   // The ring 1 <= r <= 2, 0 <= z <= 1 minus the half-space slab x >= 1.2, 0.5 <= z: removed
   // (segment of the r = 2 disk beyond x = 1.2) x 0.5 = (4 acos(0.6) - 1.2 * 1.6) * 0.5.
-  std::vector<double> rect;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) rect.insert(rect.end(), {1.0 + i, 0.0, double(j), 0.1});
-  const spline::Surface profile({KnotVector::bezier(2), KnotVector::bezier(2)}, 4, rect);
-  construct::Revolution rev;
-  rev.relative_tolerance = 1e-8;
-  VModel ring;
-  ring.properties = {"r"};
-  ring.cells.push_back({"ring", construct::revolve(profile, rev)});
+  const VModel ring = ring_model(1e-8);
   const VModel X = vmodel::boolean(ring, box("b2", {1.2, -3, 0.5}, {3, 3, 2}, 0.3), BooleanOp::subtraction);
   const slice::Locator loc(X, {.tolerance = 1e-9});
   const double exact = 3 * M_PI - (4 * std::acos(0.6) - 1.2 * 1.6) * 0.5;
