@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -377,7 +378,7 @@ struct Locator::Data {
     StepBounds bounds;    ///< second-derivative bounds (polynomial pieces with all_first)
     /// Tighter bounds near a point: the piece cut into local_div^3 sub-boxes, and for each the
     /// bounds over it and its neighbours (up to 3 x 3 x 3 sub-boxes); empty without `bounds`.
-    std::vector<StepBounds> local;
+    mutable std::vector<StepBounds> local;  ///< filled on first use, under local_once
   };
   static constexpr int local_div = 8;
   struct Cell {
@@ -411,6 +412,8 @@ struct Locator::Data {
   bool any_trim = false;
   std::vector<Cell> cells;
   std::vector<Piece> pieces;
+  std::unique_ptr<std::once_flag[]> local_once;  ///< one per piece: its local bounds computed
+  bool use_local = true;                         ///< false: whole-piece bounds only (memory)
   std::vector<double> pool;  ///< every piece's net, control point after control point
   std::vector<LocatorLeaf> leaves;
   std::vector<Node> nodes;
@@ -655,6 +658,31 @@ StepBounds step_bounds_of(const std::vector<double>& net, const Data::Piece& pc,
   return b;
 }
 
+/// The bounds over each of the local_div^3 sub-boxes of a piece and its neighbours (StepBounds
+/// of the restricted nets).
+std::vector<StepBounds> local_bounds(const std::vector<double>& all, const Data::Piece& pc, int m) {
+  std::vector<StepBounds> local(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
+  Data::Piece sub = pc;
+  sub.local.clear();
+  constexpr double S = Data::local_div;
+  for (int c = 0; c < Data::local_div; ++c)
+    for (int b = 0; b < Data::local_div; ++b)
+      for (int a = 0; a < Data::local_div; ++a) {
+        const int idx[3] = {a, b, c};
+        Vec3 lo, hi;
+        for (std::size_t d = 0; d < 3; ++d) {
+          lo[d] = std::max(0.0, (idx[d] - 1) / S);
+          hi[d] = std::min(1.0, (idx[d] + 2) / S);
+          sub.lo[d] = pc.lo[d] + lo[d] * pc.len[d];
+          sub.len[d] = (hi[d] - lo[d]) * pc.len[d];
+          sub.inv_len[d] = 1.0 / sub.len[d];
+        }
+        local[static_cast<std::size_t>(a + Data::local_div * (b + Data::local_div * c))] =
+            step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi), sub, m);
+      }
+  return local;
+}
+
 CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const LocatorOptions& opt) {
   const auto& s = vc.volume;
   CellBuild cb;
@@ -696,29 +724,9 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
       for (int h = 0; h < m; ++h) all[static_cast<std::size_t>(i * pc.nc + H + h)] = w * q[static_cast<std::size_t>(3 + h)];
     }
     pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g, pc, H);
-    if (pc.k.all_first) {
-      pc.bounds = step_bounds_of(all, pc, m);
-      // The sub-box pieces are copies of pc made before its `local` fills up (copying it in the
-      // loop copied the growing table every time: quadratic in local_div^3).
-      Data::Piece sub = pc;
-      pc.local.resize(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
-      constexpr double S = Data::local_div;
-      for (int c = 0; c < Data::local_div; ++c)
-        for (int b = 0; b < Data::local_div; ++b)
-          for (int a = 0; a < Data::local_div; ++a) {
-            const int idx[3] = {a, b, c};
-            Vec3 lo, hi;
-            for (std::size_t d = 0; d < 3; ++d) {
-              lo[d] = std::max(0.0, (idx[d] - 1) / S);
-              hi[d] = std::min(1.0, (idx[d] + 2) / S);
-              sub.lo[d] = pc.lo[d] + lo[d] * pc.len[d];
-              sub.len[d] = (hi[d] - lo[d]) * pc.len[d];
-              sub.inv_len[d] = 1.0 / sub.len[d];
-            }
-            pc.local[static_cast<std::size_t>(a + Data::local_div * (b + Data::local_div * c))] =
-                step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi), sub, m);
-          }
-    }
+    // The local bounds (local_div^3 sub-boxes) are computed on first use (step_bounds): a
+    // model of thousands of pieces would otherwise pay seconds here for pieces no voxel needs.
+    if (pc.k.all_first) pc.bounds = step_bounds_of(all, pc, m);
     std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
     build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.max_leaves_per_piece, lv);
     for (const auto& [box, fl] : lv) {
@@ -840,6 +848,13 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
     D.cells.push_back(std::move(cb.cell));
   }
   build_bvh(D);
+  D.local_once = std::make_unique<std::once_flag[]>(D.pieces.size());
+  // Local bounds cost local_div^3 StepBounds per piece (about 250 kB) and milliseconds to
+  // compute: for models of thousands of pieces (finely refined cells) the whole-piece bounds
+  // serve instead, a few more anchors against gigabytes and seconds.
+  constexpr double local_budget = 256.0 * 1024 * 1024;
+  D.use_local = static_cast<double>(D.pieces.size()) * Data::local_div * Data::local_div * Data::local_div *
+                    static_cast<double>(sizeof(StepBounds)) <= local_budget;
   // Booleans' trimming: one locator per condition, built recursively (their cells may be
   // trimmed too).
   D.trims.resize(static_cast<std::size_t>(nc));
@@ -1047,7 +1062,13 @@ const StepBounds& Locator::step_bounds(int piece) const noexcept { return data_-
 
 const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
   const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
-  if (pc.local.empty()) return pc.bounds;
+  if (!pc.k.all_first || !data_->use_local) return pc.bounds;
+  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] {
+    const std::size_t n = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+    const std::vector<double> all(data_->pool.begin() + static_cast<std::ptrdiff_t>(pc.net),
+                                  data_->pool.begin() + static_cast<std::ptrdiff_t>(pc.net + n));
+    pc.local = local_bounds(all, pc, data_->m);
+  });
   double s[3];
   Data::local(pc, t, s);
   int idx[3];
