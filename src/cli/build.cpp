@@ -28,11 +28,6 @@ struct Options {
   bool force = false;
 };
 
-double extent(const vmodel::VModel& m) {
-  const auto b = slice::model_bounds(m);
-  return std::hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]);
-}
-
 struct CellQuality {
   bool checked = false;  ///< false for a rational trivariate, which check_validity does not decide
   geom::ValidityReport<3> validity;
@@ -153,7 +148,7 @@ void add_build(CLI::App& app, Common& common) {
     bool trimmed = false;
     for (const auto& c : built.model.cells) trimmed = trimmed || !c.plain();
     if (trimmed) {
-      const slice::Locator loc(built.model, {.tolerance = 1e-9 * std::max(1e-300, extent(built.model))});
+      const slice::Locator loc(built.model, {.tolerance = 1e-9 * slice::model_diagonal(built.model)});
       tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
         if (!built.model.cells[i].plain()) q[i].volume = slice::trimmed_volume(loc, static_cast<int>(i));
       });

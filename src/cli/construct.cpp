@@ -44,18 +44,14 @@ struct Verdict {
   double min_jacobian = 0.0, max_jacobian = 0.0;
 };
 
-bool planar(const spline::Surface& s) {
+/// xy only, or xyz with one z for every control point.
+template <int P>
+bool planar(const spline::TensorSpline<P>& s) {
+  if (s.dim() < 2) return false;
   if (s.dim() == 2) return true;
   for (int i = 1; i < s.size(); ++i)
     if (s.point(i)[2] != s.point(0)[2]) return false;
-  return s.dim() >= 2;
-}
-
-bool planar_curve(const spline::Curve& c) {
-  if (c.dim() == 2) return true;
-  for (int i = 1; i < c.size(); ++i)
-    if (c.point(i)[2] != c.point(0)[2]) return false;
-  return c.dim() >= 2;
+  return true;
 }
 
 Verdict verdict_of(const spline::Surface& s) {
@@ -74,7 +70,7 @@ Verdict verdict_of(const spline::Trivariate& t) {
 void check_simple(const io::ConstructInput& in, const std::string& file) {
   if (in.curves.empty() || in.op == "extrude" || in.op == "revolve" || in.op == "sweep") return;
   for (const auto& c : in.curves)
-    if (!planar_curve(c)) return;
+    if (!planar(c)) return;
   double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
   for (const auto& c : in.curves)
     for (int i = 0; i < c.size(); ++i)
@@ -187,7 +183,7 @@ void run(const Options& opt, const io::ConstructInput& in, Common& common) {
       const construct::KernelOp op = construct::kernel_op_from_name(in.op);
       if constexpr (P == 2) {
         for (std::size_t i = 0; i < in.curves.size(); ++i)
-          if (!planar_curve(in.curves[i]))
+          if (!planar(in.curves[i]))
             throw Error("/curves/" + std::to_string(i) + ": a curve that leaves the plane z = const; expected planar "
                         "curves for a kernel-based surface");
         r = construct::kernel_construct(op, in.curves, ko);

@@ -39,12 +39,6 @@ bool any_trimmed_cell(const vmodel::VModel& m) {
   return false;
 }
 
-/// The diagonal of the cells' control boxes (for a tolerance relative to the model's size).
-double model_extent(const vmodel::VModel& m) {
-  const auto b = slice::model_bounds(m);
-  return std::max(1e-300, std::hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]));
-}
-
 nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& file) {
   nlohmann::ordered_json cells = nlohmann::ordered_json::array();
   std::vector<double> volumes(m.cells.size());
@@ -57,7 +51,7 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
     any_trimmed = any_trimmed || trimmed[i];
   }
   if (any_trimmed) {
-    const slice::Locator loc(m, {.tolerance = 1e-9 * model_extent(m)});
+    const slice::Locator loc(m, {.tolerance = 1e-9 * slice::model_diagonal(m)});
     tbb::parallel_for(std::size_t{0}, m.cells.size(), [&](std::size_t i) {
       if (trimmed[i]) volumes[i] = (volumes[i] < 0 ? -1.0 : 1.0) * slice::trimmed_volume(loc, static_cast<int>(i));
     });

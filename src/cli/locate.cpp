@@ -50,7 +50,7 @@ void add_locate(CLI::App& app, Common& common) {
       std::copy(v.begin(), v.begin() + 3, x.begin());
       std::copy(v.begin() + 3, v.end(), props.begin());
       // A Boolean's intersection cell blends its inputs' properties (VCell::blend).
-      if (!props.empty()) locator.blend_properties(r.cell, q, props.data());
+      if (!props.empty()) locator.admits(r.cell, q, props.data());
       j["cell"] = model.cells[static_cast<std::size_t>(r.cell)].name;
       j["uvw"] = r.uvw;
       j["point"] = x;

@@ -508,8 +508,12 @@ Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const Su
 // ---------------------------------------------------------------------------------------------
 // Sweep
 
+namespace {
+
+/// sweep_params for sections already in their common space (`cs`, empty until needed).
 template <int P>
-std::vector<double> sweep_params(std::span<const TensorSpline<P - 1>> sections_in, std::span<const double> params) {
+std::vector<double> params_of(std::span<const TensorSpline<P - 1>> sections_in, std::span<const double> params,
+                              std::vector<TensorSpline<P - 1>>& cs) {
   const std::size_t n = sections_in.size();
   if (n < 2) throw Error("sweep through " + std::to_string(n) + " section(s); expected at least 2");
   if (!params.empty()) {
@@ -530,7 +534,7 @@ std::vector<double> sweep_params(std::span<const TensorSpline<P - 1>> sections_i
   }
   // Chord length between consecutive sections: the root mean square distance of their control
   // points in the common space (NURBS Book eq. 9.5, averaged over the net as in Sec. 9.2.5).
-  const auto cs = common_space<P - 1>(sections_in);
+  if (cs.empty()) cs = common_space<P - 1>(sections_in);
   const int coords = std::min(3, cs[0].dim());
   std::vector<double> t(n, 0.0);
   for (std::size_t i = 1; i < n; ++i) {
@@ -552,6 +556,14 @@ std::vector<double> sweep_params(std::span<const TensorSpline<P - 1>> sections_i
   return t;
 }
 
+}  // namespace
+
+template <int P>
+std::vector<double> sweep_params(std::span<const TensorSpline<P - 1>> sections, std::span<const double> params) {
+  std::vector<TensorSpline<P - 1>> cs;
+  return params_of<P>(sections, params, cs);
+}
+
 namespace {
 
 template <int P>
@@ -559,9 +571,10 @@ TensorSpline<P> sweep_impl(std::span<const TensorSpline<P - 1>> sections, std::s
                            int order) {
   for (std::size_t i = 0; i < sections.size(); ++i)
     require_polynomial(sections[i], "sweep section " + std::to_string(i));
-  const std::vector<double> t = sweep_params<P>(sections, params_in);
+  std::vector<TensorSpline<P - 1>> cs;
+  const std::vector<double> t = params_of<P>(sections, params_in, cs);
   if (order < 1) throw Error("sweep order " + std::to_string(order) + "; expected >= 1");
-  const auto cs = common_space<P - 1>(sections);
+  if (cs.empty()) cs = common_space<P - 1>(sections);
   const int n = static_cast<int>(cs.size());
   const int k = std::min(order, n);
   // Interpolating every control point's sequence at once: one curve in R^(size * dim), linear in

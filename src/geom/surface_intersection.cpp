@@ -96,22 +96,6 @@ public:
     return false;
   }
 
-  bool on_boundary(const IntersectionPoint& p, int& index, double& value) const {
-    const double eps = 1e-12;
-    const double v[4] = {p.uv1[0], p.uv1[1], p.uv2[0], p.uv2[1]};
-    for (int k = 0; k < 4; ++k) {
-      const Box2& d = k < 2 ? da_ : db_;
-      const double lo = d.lo[static_cast<std::size_t>(k & 1)], hi = d.hi[static_cast<std::size_t>(k & 1)];
-      const double w = (hi - lo) * eps;
-      if (v[k] <= lo + w || v[k] >= hi - w) {
-        index = k;
-        value = v[k] <= lo + w ? lo : hi;
-        return true;
-      }
-    }
-    return false;
-  }
-
   /// Unit tangent n_1 x n_2 at p (zero where the surfaces touch tangentially), and the rate of
   /// change of the four parameters along it.
   bool tangent(const IntersectionPoint& p, V3& T, Eigen::Vector4d& dt) const {

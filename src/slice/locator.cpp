@@ -894,70 +894,46 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
 bool Locator::trimmed(int cell) const noexcept { return data_->trims[static_cast<std::size_t>(cell)] != nullptr; }
 bool Locator::has_trims() const noexcept { return data_->any_trim; }
 
-bool Locator::admits(int cell, const Vec3& p) const {
+bool Locator::admits(int cell, const Vec3& p, double* props) const {
   const auto& trim = data_->trims[static_cast<std::size_t>(cell)];
   if (!trim) return true;
-  for (const auto& w : trim->within)
-    if (!w->loc->locate(p).inside) return false;
   for (const auto& o : trim->without)
     if (o->loc->locate(p).inside) return false;
-  return true;
-}
-
-void Locator::blend_properties(int cell, const Vec3& p, double* props) const {
-  const auto& trim = data_->trims[static_cast<std::size_t>(cell)];
   const int m = data_->m;
-  if (!trim || trim->blend == vmodel::BlendRule::first || m == 0) return;
-  std::vector<double> other(static_cast<std::size_t>(m));
-  if (trim->blend == vmodel::BlendRule::distance) {
-    // Seed 003 Eq. 2: sum_i d_i^k A_i / sum_i d_i^k, d_i the distance to input i's boundary.
-    std::vector<double> acc(static_cast<std::size_t>(m), 0.0), mean(props, props + m);
-    const auto weight = [&](std::size_t i) { return std::pow(geom::distance(trim->boundaries[i], p), trim->power); };
-    double wsum = weight(0);
-    for (int h = 0; h < m; ++h) acc[static_cast<std::size_t>(h)] = wsum * props[h];
-    int count = 1;
-    for (std::size_t k = 0; k < trim->within.size(); ++k) {
-      const auto& w = trim->within[k];
-      const auto r = w->loc->locate(p);
-      if (!r.inside) continue;
-      double x[3];
-      w->loc->eval(r.cell, r.uvw, x, other.data());
-      w->loc->blend_properties(r.cell, p, other.data());
-      const double wk = weight(k + 1);
-      wsum += wk;
-      ++count;
-      for (int h = 0; h < m; ++h) {
-        acc[static_cast<std::size_t>(h)] += wk * other[static_cast<std::size_t>(h)];
-        mean[static_cast<std::size_t>(h)] += other[static_cast<std::size_t>(h)];
-      }
-    }
-    // On every input's boundary at once (Eq. 2's singular points): the plain mean.
-    for (int h = 0; h < m; ++h)
-      props[h] = wsum > 0 ? acc[static_cast<std::size_t>(h)] / wsum : mean[static_cast<std::size_t>(h)] / count;
-    return;
-  }
-  int count = 1;
+  const bool blend = props && m > 0 && trim->blend != vmodel::BlendRule::first;
+  // The values to combine: the cell's own (props on entry), then each within cell's at p, with
+  // its own blend applied; each within cell must hold p.
+  std::vector<double> values;
+  if (blend) values.assign(props, props + m);
   for (const auto& w : trim->within) {
     const auto r = w->loc->locate(p);
-    if (!r.inside) continue;  // only within the tolerance of its boundary
+    if (!r.inside) return false;
+    if (!blend) continue;
+    const std::size_t at = values.size();
+    values.resize(at + static_cast<std::size_t>(m));
     double x[3];
-    w->loc->eval(r.cell, r.uvw, x, other.data());
-    w->loc->blend_properties(r.cell, p, other.data());
-    for (int h = 0; h < m; ++h) props[h] += other[static_cast<std::size_t>(h)];
-    ++count;
+    w->loc->eval(r.cell, r.uvw, x, values.data() + at);
+    w->loc->admits(r.cell, p, values.data() + at);
   }
+  if (!blend) return true;
+  const std::size_t n = values.size() / static_cast<std::size_t>(m);
+  // Weights: 1 for the sum and the mean; seed 003 Eq. 2's d_i^k for the distance blend, d_i the
+  // distance to input i's boundary (on every input's boundary at once, Eq. 2's singular points,
+  // the plain mean).
+  std::vector<double> w(n, 1.0);
+  if (trim->blend == vmodel::BlendRule::distance) {
+    double wsum = 0.0;
+    for (std::size_t i = 0; i < n; ++i) wsum += w[i] = std::pow(geom::distance(trim->boundaries[i], p), trim->power);
+    if (!(wsum > 0)) std::fill(w.begin(), w.end(), 1.0);
+  }
+  double wsum = 0.0;
+  for (double x : w) wsum += x;
   for (int h = 0; h < m; ++h) {
-    if (trim->blend == vmodel::BlendRule::sum_clip) props[h] = std::clamp(props[h], 0.0, 1.0);
-    else props[h] /= count;
+    double acc = 0.0;
+    for (std::size_t i = 0; i < n; ++i) acc += w[i] * values[i * static_cast<std::size_t>(m) + static_cast<std::size_t>(h)];
+    props[h] = trim->blend == vmodel::BlendRule::sum_clip ? std::clamp(acc, 0.0, 1.0) : acc / wsum;
   }
-}
-
-void Locator::blend_properties(int cell, const Vec3& p, float* props) const {
-  if (!trimmed(cell)) return;
-  const int m = data_->m;
-  std::vector<double> d(props, props + m);
-  blend_properties(cell, p, d.data());
-  for (int h = 0; h < m; ++h) props[h] = static_cast<float>(d[static_cast<std::size_t>(h)]);
+  return true;
 }
 
 Locator::~Locator() = default;
@@ -1265,6 +1241,11 @@ std::array<Vec3, 2> model_bounds(const vmodel::VModel& model) {
     }
   }
   return b;
+}
+
+double model_diagonal(const vmodel::VModel& model) {
+  const auto b = model_bounds(model);
+  return std::max(std::numeric_limits<double>::min(), std::hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]));
 }
 
 }  // namespace trivox::slice

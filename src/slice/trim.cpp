@@ -23,9 +23,8 @@ void apply_trimming(const Locator& loc, const VoxelGrid& grid, RowBand& band) {
       const Vec3 p = grid.centre(i, j, band.layer);
       float* vp = band.props.data() + v * static_cast<std::size_t>(m);
       double* vu = with_uvw ? band.uvw.data() + 3 * v : nullptr;
-      if (loc.admits(c, p)) {
-        std::copy(vp, vp + m, props.begin());
-        loc.blend_properties(c, p, props.data());
+      std::copy(vp, vp + m, props.begin());
+      if (loc.admits(c, p, props.data())) {
         std::copy(props.begin(), props.end(), vp);
         continue;
       }
@@ -39,7 +38,7 @@ void apply_trimming(const Locator& loc, const VoxelGrid& grid, RowBand& band) {
       band.cell[v] = res.cell;
       double x[3];
       loc.eval(res.cell, res.uvw, x, props.data());
-      loc.blend_properties(res.cell, p, props.data());
+      loc.admits(res.cell, p, props.data());  // admitted by locate: blends
       std::transform(props.begin(), props.end(), vp, [](double d) { return static_cast<float>(d); });
       if (vu) std::copy(res.uvw.begin(), res.uvw.end(), vu);
     }
@@ -152,9 +151,7 @@ vmodel::VModel untrim(const vmodel::VModel& model) {
   bool any = false;
   for (const auto& c : model.cells) any = any || !c.plain();
   if (!any) return out;
-  const auto b = model_bounds(model);
-  const double extent = std::hypot(b[1][0] - b[0][0], b[1][1] - b[0][1], b[1][2] - b[0][2]);
-  const Locator loc(model, {.tolerance = std::max(1e-300, 1e-10 * extent)});
+  const Locator loc(model, {.tolerance = 1e-10 * model_diagonal(model)});
   for (std::size_t c = 0; c < model.cells.size(); ++c) {
     if (model.cells[c].plain()) continue;
     Vec3 lo, hi;

@@ -125,7 +125,7 @@ TEST_CASE("union intersection and subtraction of two boxes: exact membership and
   double x[3], v[1];
   loc.eval(r.cell, r.uvw, x, v);
   CHECK(v[0] == Approx(0.25));
-  loc.blend_properties(r.cell, p, v);
+  CHECK(loc.admits(r.cell, p, v));
   CHECK(v[0] == Approx(0.75));
   for (auto [rule, expect] : {std::pair{vmodel::BlendRule::mean, 0.375}, std::pair{vmodel::BlendRule::first, 0.25}}) {
     const VModel I = vmodel::boolean(A, B, BooleanOp::intersection, {.blend = rule});
@@ -133,7 +133,7 @@ TEST_CASE("union intersection and subtraction of two boxes: exact membership and
     const auto ri = li.locate(p);
     REQUIRE(ri.inside);
     li.eval(ri.cell, ri.uvw, x, v);
-    li.blend_properties(ri.cell, p, v);
+    CHECK(li.admits(ri.cell, p, v));
     CHECK(v[0] == Approx(expect));
   }
   // Sum clipped to 1.
@@ -141,7 +141,7 @@ TEST_CASE("union intersection and subtraction of two boxes: exact membership and
   const slice::Locator lh(H, {.tolerance = 1e-9});
   const auto rh = lh.locate(p);
   lh.eval(rh.cell, rh.uvw, x, v);
-  lh.blend_properties(rh.cell, p, v);
+  CHECK(lh.admits(rh.cell, p, v));
   CHECK(v[0] == 1.0);
 }
 
@@ -213,7 +213,7 @@ TEST_CASE("the distance blend of seed 003 Eq. 2 weights each input by its bounda
       REQUIRE(r.inside);
       double x[3], v[1];
       loc.eval(r.cell, r.uvw, x, v);
-      loc.blend_properties(r.cell, p, v);
+      CHECK(loc.admits(r.cell, p, v));
       CHECK(v[0] == Approx(expect).margin(1e-9));
     }
     // On A's boundary inside B only B's value remains (C0 with B - A), and vice versa.
@@ -222,7 +222,7 @@ TEST_CASE("the distance blend of seed 003 Eq. 2 weights each input by its bounda
       REQUIRE(r.inside);
       double x[3], v[1];
       loc.eval(r.cell, r.uvw, x, v);
-      loc.blend_properties(r.cell, p, v);
+      CHECK(loc.admits(r.cell, p, v));
       CHECK(v[0] == Approx(expect).margin(1e-9));
     }
   }

@@ -209,14 +209,13 @@ public:
   bool trimmed(int cell) const noexcept;
   /// Whether p (inside cell c's trivariate) satisfies c's trimming: inside every `within` cell
   /// and in no cell of any `without` solid, each decided by its own locator (so exactly, up to
-  /// the tolerance). Always true for plain cells.
-  bool admits(int cell, const Vec3& p) const;
-  /// Cell c's properties at p by its blend rule: `props` holds the trivariate's own m values
-  /// on entry; the within cells' values at p (their own blends applied) are combined with them
-  /// (sum clipped to [0, 1], the mean, or seed 003 Eq. 2's distance weights: one closest-point
-  /// query per boundary surface of each input). Unchanged for plain cells and BlendRule::first.
-  void blend_properties(int cell, const Vec3& p, double* props) const;
-  void blend_properties(int cell, const Vec3& p, float* props) const;
+  /// the tolerance). Always true for plain cells. When `props` is not null it holds the
+  /// trivariate's own m values on entry and, if p is admitted, leaves with c's blended
+  /// properties: combined with the within cells' values at p (their own blends applied) by the
+  /// cell's rule (sum clipped to [0, 1], the mean, or seed 003 Eq. 2's distance weights: one
+  /// closest-point query per boundary surface of each input). Unchanged for plain cells and
+  /// BlendRule::first. One point location per condition, whether or not props are wanted.
+  bool admits(int cell, const Vec3& p, double* props = nullptr) const;
   const LocatorOptions& options() const noexcept;
 
   // ---- Building blocks for the layer sampler (and anyone walking many coherent points) ----
@@ -276,6 +275,11 @@ private:
 /// their Bezier pieces (spline::bounding_box): what the voxel grid covers (grid.hpp).
 /// @throws Error (bad_input) for a model without cells
 std::array<Vec3, 2> model_bounds(const vmodel::VModel& model);
+
+/// The diagonal of model_bounds: the model's size, for tolerances relative to it (> 0: at least
+/// the smallest positive double).
+/// @throws Error (bad_input) for a model without cells
+double model_diagonal(const vmodel::VModel& model);
 
 // ---- definitions ----
 

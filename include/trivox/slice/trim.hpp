@@ -6,7 +6,7 @@
 /// For a model with trimmed cells this pass then corrects every voxel owned by a trimmed cell:
 /// where the cell's conditions do not admit the centre (Locator::admits), the voxel goes to the
 /// cell that does hold it (Locator::locate, which honours the trimming) or becomes void; where
-/// they do, its properties are blended by the cell's rule (Locator::blend_properties). So
+/// they do, its properties are blended by the cell's rule (in the same Locator::admits). So
 /// occupancy is exactly Locator::locate's answer for these voxels, and the properties of an
 /// intersection cell are the blend of its inputs' values at the centre.
 ///
