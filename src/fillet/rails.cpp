@@ -373,6 +373,12 @@ private:
     return nullptr;
   }
 
+  bool trimmed_between(std::size_t i, double a, double b) const {
+    for (const Trim& m : trims_[i])
+      if (a >= m.t0 && b <= m.t1) return true;
+    return false;
+  }
+
   void set_rails(Sample& s) const {
     for (std::size_t i = 0; i < 2; ++i) {
       const Trim* m = trim_at(i, s.t);
@@ -471,8 +477,7 @@ private:
         const V3 T = f1.normal().cross(f2.normal()).normalized();
         for (std::size_t i = 0; i < 2; ++i) {
           double e = gap;
-          const Trim* m = trim_at(i, a.t);
-          if (!(m && b.t <= m->t1)) {
+          if (!trimmed_between(i, a.t, b.t)) {
             const V3 P = faces_[i].point(eval2(fitted_[2 * i + 1], t)) - C;
             e = std::max({e, std::abs(P.norm() - d_[i]), std::abs(P.dot(T))});
           }
