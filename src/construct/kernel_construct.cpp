@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -228,6 +230,120 @@ void move_interior(TensorSpline<P>& s, const std::array<double, P>& k, double wi
 }
 
 template <int P>
+using KernelOf = std::conditional_t<P == 2, geom::PlanarKernel, geom::SpatialKernel>;
+
+/// det J of s with every interior control point at K (plus the Sec. 6 offsets for width > 0)
+/// is affine in K (the terms with K twice are cross products of K with itself). Per Bezier
+/// piece, one spline with P + 1 coordinates per coefficient: (D_0, G_1, .., G_P), det J(K) =
+/// D_0 + sum_d K_d G_d, from s with its interior at 0 and at each unit vector.
+template <int P>
+std::vector<TensorSpline<P>> affine_determinant(const TensorSpline<P>& s, double width, int orientation) {
+  std::array<std::vector<TensorSpline<P>>, P + 1> pieces;
+  for (int d = 0; d <= P; ++d) {
+    std::array<double, P> k{};
+    if (d > 0) k[static_cast<std::size_t>(d - 1)] = 1.0;
+    TensorSpline<P> x = s;
+    move_interior<P>(x, k, width, orientation);
+    pieces[static_cast<std::size_t>(d)] = spline::bezier_pieces(x);
+  }
+  std::vector<TensorSpline<P>> out;
+  for (std::size_t j = 0; j < pieces[0].size(); ++j) {
+    std::array<TensorSpline<P>, P + 1> det;
+    for (int d = 0; d <= P; ++d) det[static_cast<std::size_t>(d)] = piece_determinant(pieces[static_cast<std::size_t>(d)][j]);
+    const int n = det[0].size();
+    std::vector<double> pts(static_cast<std::size_t>(n * (P + 1)));
+    for (int r = 0; r < n; ++r) {
+      const double c0 = det[0].point(r)[0];
+      pts[static_cast<std::size_t>(r * (P + 1))] = c0;
+      for (int d = 1; d <= P; ++d)
+        pts[static_cast<std::size_t>(r * (P + 1) + d)] = det[static_cast<std::size_t>(d)].point(r)[0] - c0;
+    }
+    out.emplace_back(det[0].knot_vectors(), P + 1, std::move(pts));
+  }
+  return out;
+}
+
+/// The constraints a piece of the affine det J puts on K inside the kernel (vertices `verts`):
+/// none when every coefficient has the sign `orientation` (within tau) at every vertex; else
+/// the piece halved in every direction, up to `levels` times; at the last level, one
+/// half-space per coefficient that can have the wrong sign. False when some coefficient has
+/// the wrong sign at every vertex (no K in the kernel can satisfy it).
+template <int P>
+bool collect_constraints(const TensorSpline<P>& piece, int levels, const std::vector<std::array<double, P>>& verts,
+                         int orientation, double tau, std::vector<std::array<double, P + 1>>& out) {
+  bool fine = true;
+  for (int r = 0; r < piece.size() && fine; ++r) {
+    const auto c = piece.point(r);
+    for (const auto& v : verts) {
+      double val = c[0];
+      for (int d = 0; d < P; ++d) val += c[static_cast<std::size_t>(d + 1)] * v[static_cast<std::size_t>(d)];
+      if (orientation * val < -tau) {
+        fine = false;
+        break;
+      }
+    }
+  }
+  if (fine) return true;
+  if (levels > 0) {
+    std::vector<TensorSpline<P>> parts{piece};
+    for (int d = 0; d < P; ++d) {
+      std::vector<TensorSpline<P>> next;
+      for (const auto& x : parts) {
+        auto [a, b] = spline::split(x, d, 0.5 * (x.domain(d)[0] + x.domain(d)[1]));
+        next.push_back(std::move(a));
+        next.push_back(std::move(b));
+      }
+      parts = std::move(next);
+    }
+    for (const auto& x : parts)
+      if (!collect_constraints<P>(x, levels - 1, verts, orientation, tau, out)) return false;
+    return true;
+  }
+  for (int r = 0; r < piece.size(); ++r) {
+    const auto c = piece.point(r);
+    double hi = -HUGE_VAL, lo = HUGE_VAL;
+    for (const auto& v : verts) {
+      double val = c[0];
+      for (int d = 0; d < P; ++d) val += c[static_cast<std::size_t>(d + 1)] * v[static_cast<std::size_t>(d)];
+      hi = std::max(hi, orientation * val);
+      lo = std::min(lo, orientation * val);
+    }
+    if (lo >= -tau) continue;
+    if (hi < -tau) return false;
+    std::array<double, P + 1> h{};
+    for (int d = 0; d < P; ++d) h[static_cast<std::size_t>(d)] = orientation * c[static_cast<std::size_t>(d + 1)];
+    h[P] = orientation * c[0] + tau;
+    out.push_back(h);
+  }
+  return true;
+}
+
+/// KernelPoint::fitted: the centroid of the part of the kernel where every (subdivided) Bezier
+/// coefficient of det J has the boundary's sign, when it has positive measure.
+template <int P>
+std::optional<std::array<double, P>> fitted_point(const TensorSpline<P>& s, const KernelOf<P>& kern,
+                                                  const std::array<double, P>& centroid, double width, int orientation,
+                                                  int levels) {
+  const auto pieces = affine_determinant(s, width, orientation);
+  // The scale of det J at the centroid, for the same relative tolerance as jacobian_nonnegative.
+  double scale = 0.0;
+  for (const auto& x : pieces)
+    for (int r = 0; r < x.size(); ++r) {
+      const auto c = x.point(r);
+      double val = c[0];
+      for (int d = 0; d < P; ++d) val += c[static_cast<std::size_t>(d + 1)] * centroid[static_cast<std::size_t>(d)];
+      scale = std::max(scale, std::abs(val));
+    }
+  const double tau = 1e-9 * scale;
+  std::vector<std::array<double, P + 1>> constraints;
+  for (const auto& x : pieces)
+    if (!collect_constraints<P>(x, std::max(0, levels), kern.vertices, orientation, tau, constraints)) return std::nullopt;
+  const auto region = geom::restrict_kernel(kern, constraints);
+  if (region.empty()) return std::nullopt;
+  return region.centroid;
+}
+
+template <int P>
 bool accepted(const TensorSpline<P>& s, int orientation, const KernelConstructOptions& o) {
   if (o.acceptance == Acceptance::positive) {
     const auto r = geom::check_validity(s, o.validity);
@@ -324,16 +440,16 @@ KernelResult<P> kernel_based(const TensorSpline<P>& s0, const KernelConstructOpt
   std::array<double, P> k{};
   int orientation = 0;
   double size = 0.0;
+  KernelOf<P> kern;
   try {
     if constexpr (P == 2) {
-      const auto kern = geom::planar_kernel(s0, o.kernel);
+      kern = geom::planar_kernel(s0, o.kernel);
       if (!kern.empty()) k = kern.centroid, r.kernel_measure = kern.area, size = std::sqrt(kern.area);
-      orientation = kern.orientation;
     } else {
-      const auto kern = geom::spatial_kernel(s0, o.kernel);
+      kern = geom::spatial_kernel(s0, o.kernel);
       if (!kern.empty()) k = kern.centroid, r.kernel_measure = kern.volume, size = std::cbrt(kern.volume);
-      orientation = kern.orientation;
     }
+    orientation = kern.orientation;
   } catch (const Error& e) {
     r.reason = std::string("the regular construction is invalid and its boundary has no kernel (") + e.what() + ")";
     return r;
@@ -350,7 +466,16 @@ KernelResult<P> kernel_based(const TensorSpline<P>& s0, const KernelConstructOpt
     TensorSpline<P> s = add_dof(s0, o.add_dof, i);
     move_interior<P>(s, k, o.spread * size, orientation);
     r.iterations = i;
-    const bool ok = accepted(s, orientation, o);
+    r.point = k;
+    r.fitted = false;
+    bool ok = accepted(s, orientation, o);
+    if (!ok && o.kernel_point == KernelPoint::fitted)
+      if (const auto f = fitted_point<P>(s, kern, k, o.spread * size, orientation, o.fit_subdivisions)) {
+        move_interior<P>(s, *f, o.spread * size, orientation);
+        ok = accepted(s, orientation, o);
+        r.point = *f;
+        r.fitted = true;
+      }
     r.spline = std::move(s);
     if (ok) {
       r.valid = true;

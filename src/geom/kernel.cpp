@@ -196,6 +196,68 @@ Surface normal_constraint(const Surface& s) {
   return side_by_side<2>({std::move(nn), std::move(d)});
 }
 
+/// Shoelace area and centroid of a clipped polygon into k (left empty for zero area).
+void finish(const std::vector<Vec2>& poly, PlanarKernel& k) {
+  k.vertices.clear();
+  k.area = 0.0;
+  if (poly.size() < 3) return;
+  double a2 = 0.0;
+  Vec2 c = Vec2::Zero();
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2& p = poly[i];
+    const Vec2& q = poly[(i + 1) % poly.size()];
+    const double w = p.x() * q.y() - q.x() * p.y();
+    a2 += w;
+    c += w * (p + q);
+  }
+  if (!(a2 > 0.0)) return;
+  k.area = 0.5 * a2;
+  c /= 3.0 * a2;
+  k.centroid = {c.x(), c.y()};
+  for (const Vec2& p : poly) k.vertices.push_back({p.x(), p.y()});
+}
+
+/// Volume, centroid, vertices and faces of a clipped polyhedron into k (left empty for zero
+/// volume); vertices within 10 eps are merged.
+void finish(const std::vector<Polygon3>& poly, double eps, SpatialKernel& k) {
+  k.vertices.clear();
+  k.faces.clear();
+  k.volume = 0.0;
+  if (poly.size() < 4) return;
+  // Volume and centroid: tetrahedra from a point inside to each face's fan triangles.
+  Vec3 ref = Vec3::Zero();
+  int count = 0;
+  for (const auto& f : poly)
+    for (const Vec3& p : f) ref += p, ++count;
+  ref /= count;
+  double vol6 = 0.0;
+  Vec3 c = Vec3::Zero();
+  for (const auto& f : poly)
+    for (std::size_t i = 1; i + 1 < f.size(); ++i) {
+      const double v = (f[0] - ref).dot((f[i] - ref).cross(f[i + 1] - ref));
+      vol6 += v;
+      c += v * (ref + f[0] + f[i] + f[i + 1]) / 4.0;
+    }
+  if (!(vol6 > 0.0)) return;
+  k.volume = vol6 / 6.0;
+  c /= vol6;
+  k.centroid = {c.x(), c.y(), c.z()};
+  for (const auto& f : poly) {
+    std::vector<int> ids;
+    for (const Vec3& p : f) {
+      int id = -1;
+      for (std::size_t j = 0; j < k.vertices.size() && id < 0; ++j)
+        if ((Vec3(k.vertices[j][0], k.vertices[j][1], k.vertices[j][2]) - p).norm() <= 10 * eps) id = static_cast<int>(j);
+      if (id < 0) {
+        id = static_cast<int>(k.vertices.size());
+        k.vertices.push_back({p.x(), p.y(), p.z()});
+      }
+      ids.push_back(id);
+    }
+    k.faces.push_back(std::move(ids));
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -271,21 +333,7 @@ PlanarKernel planar_kernel(std::span<const Curve> loop, const KernelOptions& opt
     poly = clip(poly, h, eps);
     if (poly.size() < 3) return k;
   }
-  // Shoelace area and centroid.
-  double a2 = 0.0;
-  Vec2 c = Vec2::Zero();
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec2& p = poly[i];
-    const Vec2& q = poly[(i + 1) % poly.size()];
-    const double w = p.x() * q.y() - q.x() * p.y();
-    a2 += w;
-    c += w * (p + q);
-  }
-  if (!(a2 > 0.0)) return k;
-  k.area = 0.5 * a2;
-  c /= 3.0 * a2;
-  k.centroid = {c.x(), c.y()};
-  for (const Vec2& p : poly) k.vertices.push_back({p.x(), p.y()});
+  finish(poly, k);
   return k;
 }
 
@@ -381,38 +429,7 @@ SpatialKernel spatial_kernel(std::span<const Surface> faces, const KernelOptions
     poly = clip(poly, h, eps);
     if (poly.size() < 4) return k;
   }
-  // Volume and centroid: tetrahedra from a point inside to each face's fan triangles.
-  Vec3 ref = Vec3::Zero();
-  int count = 0;
-  for (const auto& f : poly)
-    for (const Vec3& p : f) ref += p, ++count;
-  ref /= count;
-  double vol6 = 0.0;
-  Vec3 c = Vec3::Zero();
-  for (const auto& f : poly)
-    for (std::size_t i = 1; i + 1 < f.size(); ++i) {
-      const double v = (f[0] - ref).dot((f[i] - ref).cross(f[i + 1] - ref));
-      vol6 += v;
-      c += v * (ref + f[0] + f[i] + f[i + 1]) / 4.0;
-    }
-  if (!(vol6 > 0.0)) return k;
-  k.volume = vol6 / 6.0;
-  c /= vol6;
-  k.centroid = {c.x(), c.y(), c.z()};
-  for (const auto& f : poly) {
-    std::vector<int> ids;
-    for (const Vec3& p : f) {
-      int id = -1;
-      for (std::size_t j = 0; j < k.vertices.size() && id < 0; ++j)
-        if ((Vec3(k.vertices[j][0], k.vertices[j][1], k.vertices[j][2]) - p).norm() <= 10 * eps) id = static_cast<int>(j);
-      if (id < 0) {
-        id = static_cast<int>(k.vertices.size());
-        k.vertices.push_back({p.x(), p.y(), p.z()});
-      }
-      ids.push_back(id);
-    }
-    k.faces.push_back(std::move(ids));
-  }
+  finish(poly, eps, k);
   return k;
 }
 
@@ -431,6 +448,65 @@ std::vector<Surface> oriented_boundary(const Trivariate& t) {
 SpatialKernel spatial_kernel(const Trivariate& t, const KernelOptions& options) {
   const auto faces = oriented_boundary(t);
   return spatial_kernel(faces, options);
+}
+
+PlanarKernel restrict_kernel(const PlanarKernel& k, std::span<const std::array<double, 3>> constraints) {
+  PlanarKernel r;
+  r.orientation = k.orientation;
+  r.constraints = k.constraints + static_cast<int>(constraints.size());
+  if (k.empty()) return r;
+  std::vector<Vec2> poly;
+  Vec2 lo = Vec2::Constant(HUGE_VAL), hi = Vec2::Constant(-HUGE_VAL);
+  for (const auto& v : k.vertices) {
+    poly.emplace_back(v[0], v[1]);
+    lo = lo.cwiseMin(poly.back());
+    hi = hi.cwiseMax(poly.back());
+  }
+  const double eps = 1e-12 * (hi - lo).norm();
+  for (const auto& h : constraints) {
+    const double len = std::hypot(h[0], h[1]);
+    if (!(len > 0.0)) {
+      if (h[2] < 0.0) return r;
+      continue;
+    }
+    poly = clip(poly, HalfPlane{h[0] / len, h[1] / len, h[2] / len}, eps);
+    if (poly.size() < 3) return r;
+  }
+  finish(poly, r);
+  return r;
+}
+
+SpatialKernel restrict_kernel(const SpatialKernel& k, std::span<const std::array<double, 4>> constraints) {
+  SpatialKernel r;
+  r.orientation = k.orientation;
+  r.constraints = k.constraints + static_cast<int>(constraints.size());
+  if (k.empty()) return r;
+  std::vector<Polygon3> poly;
+  Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+  for (const auto& f : k.faces) {
+    Polygon3 g;
+    for (int id : f) {
+      const auto& v = k.vertices[static_cast<std::size_t>(id)];
+      g.emplace_back(v[0], v[1], v[2]);
+      lo = lo.cwiseMin(g.back());
+      hi = hi.cwiseMax(g.back());
+    }
+    poly.push_back(std::move(g));
+  }
+  const double eps = 1e-12 * (hi - lo).norm();
+  for (const auto& h : constraints) {
+    const Vec3 n(h[0], h[1], h[2]);
+    const double len = n.norm();
+    if (!(len > 0.0)) {
+      if (h[3] < 0.0) return r;
+      continue;
+    }
+    // a . x + d >= 0  <=>  (-a) . x <= d
+    poly = clip(poly, HalfSpace{-n / len, h[3] / len}, eps);
+    if (poly.size() < 4) return r;
+  }
+  finish(poly, eps, r);
+  return r;
 }
 
 }  // namespace trivox::geom

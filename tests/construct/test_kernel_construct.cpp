@@ -282,3 +282,46 @@ TEST_CASE("kernel-based half Boolean sum trivariate (seed 004 Sec. 3.2, Lemma 2)
     CHECK(gap < 1e-12);
   }
 }
+
+TEST_CASE("KernelPoint::fitted: a kernel point where det J's coefficients allow it (seed 004 Sec. 7)", "[kernel]") {
+  // From the Sec. 5.1 generator (rounded): at the kernel centroid the Jacobian folds at
+  // iteration 0; elsewhere in the kernel it does not.
+  const std::vector<Curve> c{cubic({{-1, -1}, {0.72, -0.26}, {0.47, -1.13}, {1, -1}}),
+                             cubic({{-1, 1}, {0.85, 1.35}, {1.07, 1.83}, {1, 1}}),
+                             cubic({{-1, -1}, {-1.30, -0.44}, {-0.91, -0.43}, {-1, 1}}),
+                             cubic({{1, -1}, {1.74, 0.46}, {0.04, -0.98}, {1, 1}})};
+  construct::KernelConstructOptions o;
+  o.max_dof = 0;
+  const auto at_centroid = construct::kernel_construct(KernelOp::boolean_sum, c, o);
+  REQUIRE_FALSE(at_centroid.regular_valid);
+  REQUIRE(at_centroid.kernel.has_value());
+  CHECK_FALSE(at_centroid.valid);
+  CHECK_FALSE(at_centroid.fitted);
+  CHECK(det_range(at_centroid.spline)[0] < 0.0);  // a real fold, not an artefact of the test
+
+  o.kernel_point = construct::KernelPoint::fitted;
+  const auto r = construct::kernel_construct(KernelOp::boolean_sum, c, o);
+  REQUIRE(r.valid);
+  CHECK(r.fitted);
+  CHECK(r.iterations == 0);
+  REQUIRE(r.point.has_value());
+  CHECK(*r.point != *r.kernel);
+  CHECK(*r.kernel == *at_centroid.kernel);  // `kernel` stays the centroid
+  // The fitted point lies inside the kernel polygon.
+  const auto kern = geom::planar_kernel(construct::regular_construct(KernelOp::boolean_sum, c));
+  for (std::size_t i = 0; i < kern.vertices.size(); ++i) {
+    const auto& a = kern.vertices[i];
+    const auto& b = kern.vertices[(i + 1) % kern.vertices.size()];
+    CHECK((b[0] - a[0]) * ((*r.point)[1] - a[1]) - (b[1] - a[1]) * ((*r.point)[0] - a[0]) >= 0.0);
+  }
+  const auto range = det_range(r.spline);
+  CHECK(range[0] >= -1e-12 * range[1]);
+  CHECK(r.strictly_valid == (geom::check_validity(r.spline).verdict == geom::Validity::valid));
+  check_boolean_sum_boundaries(r.spline, c);
+  for (int row = 0; row < r.spline.size(); ++row) {
+    const auto ij = r.spline.multi_index(row);
+    if (ij[0] == 0 || ij[1] == 0 || ij[0] == r.spline.count(0) - 1 || ij[1] == r.spline.count(1) - 1) continue;
+    CHECK(r.spline.point(row)[0] == (*r.point)[0]);
+    CHECK(r.spline.point(row)[1] == (*r.point)[1]);
+  }
+}

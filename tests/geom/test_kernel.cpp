@@ -291,3 +291,36 @@ TEST_CASE("a degenerate face contributes no constraint: a triangular prism", "[k
   CHECK(k.centroid[1] == Approx(1.0 / 3).epsilon(1e-10));
   CHECK(k.centroid[2] == Approx(1.0).epsilon(1e-10));
 }
+
+TEST_CASE("restrict_kernel cuts a kernel by further half-planes (half-spaces)", "[kernel]") {
+  // The unit square's kernel cut by x + y >= 1: the triangle (1,0) (1,1) (0,1).
+  const auto square = geom::planar_kernel(polygon({{0, 0}, {1, 0}, {1, 1}, {0, 1}}));
+  const std::vector<std::array<double, 3>> cut{{1.0, 1.0, -1.0}};
+  const auto tri = geom::restrict_kernel(square, cut);
+  REQUIRE_FALSE(tri.empty());
+  CHECK(tri.area == Approx(0.5).epsilon(1e-12));
+  CHECK(tri.centroid[0] == Approx(2.0 / 3).epsilon(1e-12));
+  CHECK(tri.centroid[1] == Approx(2.0 / 3).epsilon(1e-12));
+  CHECK(tri.orientation == square.orientation);
+  // A constraint without a direction keeps everything (c >= 0) or nothing (c < 0).
+  const std::vector<std::array<double, 3>> keep{{0.0, 0.0, 1.0}}, none{{0.0, 0.0, -1.0}};
+  CHECK(geom::restrict_kernel(square, keep).area == Approx(1.0).epsilon(1e-12));
+  CHECK(geom::restrict_kernel(square, none).empty());
+  // Cut away entirely: x >= 2.
+  const std::vector<std::array<double, 3>> away{{1.0, 0.0, -2.0}};
+  CHECK(geom::restrict_kernel(square, away).empty());
+
+  // The box [0,2] x [0,3] x [0,4] cut by x >= 1 and z <= 1: [1,2] x [0,3] x [0,1].
+  const auto k = geom::spatial_kernel(box({0, 0, 0}, {2, 3, 4}));
+  const std::vector<std::array<double, 4>> cuts{{1.0, 0.0, 0.0, -1.0}, {0.0, 0.0, -1.0, 1.0}};
+  const auto r = geom::restrict_kernel(k, cuts);
+  REQUIRE_FALSE(r.empty());
+  CHECK(r.volume == Approx(3.0).epsilon(1e-10));
+  CHECK(r.centroid[0] == Approx(1.5).epsilon(1e-10));
+  CHECK(r.centroid[1] == Approx(1.5).epsilon(1e-10));
+  CHECK(r.centroid[2] == Approx(0.5).epsilon(1e-10));
+  CHECK(r.vertices.size() == 8);
+  CHECK(r.faces.size() == 6);
+  const std::vector<std::array<double, 4>> outside{{1.0, 0.0, 0.0, -3.0}};
+  CHECK(geom::restrict_kernel(k, outside).empty());
+}

@@ -66,55 +66,90 @@ struct Rng {
   double uniform(double a, double b) { return a + (b - a) * static_cast<double>(next() >> 11) * 0x1.0p-53; }
 };
 
-/// A random curve from `from` to `to` with inner control points in the box [lo, hi]; `sorted`:
-/// the inner points ordered along the direction from `from` to `to`.
-Curve random_curve(Rng& rng, Kind kind, std::array<double, 2> from, std::array<double, 2> to, std::array<double, 2> lo,
-                   std::array<double, 2> hi, bool sorted) {
+using V2 = std::array<double, 2>;
+
+double cross(const V2& a, const V2& b) { return a[0] * b[1] - a[1] * b[0]; }
+V2 sub(const V2& a, const V2& b) { return {a[0] - b[0], a[1] - b[1]}; }
+
+using Ctl = std::vector<V2>;
+
+/// The control points of a random curve from `from` to `to` with inner control points in the
+/// box [lo, hi]; `sorted`: the inner points ordered along the direction from `from` to `to`.
+Ctl random_points(Rng& rng, Kind kind, V2 from, V2 to, V2 lo, V2 hi, bool sorted) {
   const int n = kind == Kind::cubic ? 4 : 5;
-  std::vector<std::array<double, 2>> inner;
-  for (int i = 1; i + 1 < n; ++i) inner.push_back({rng.uniform(lo[0], hi[0]), rng.uniform(lo[1], hi[1])});
+  Ctl p{from};
+  for (int i = 1; i + 1 < n; ++i) p.push_back({rng.uniform(lo[0], hi[0]), rng.uniform(lo[1], hi[1])});
   if (sorted) {
-    const int axis = from[0] == to[0] ? 1 : 0;
-    const bool up = to[static_cast<std::size_t>(axis)] > from[static_cast<std::size_t>(axis)];
-    std::sort(inner.begin(), inner.end(), [&](const auto& a, const auto& b) {
-      return up ? a[static_cast<std::size_t>(axis)] < b[static_cast<std::size_t>(axis)]
-                : a[static_cast<std::size_t>(axis)] > b[static_cast<std::size_t>(axis)];
-    });
+    const auto axis = static_cast<std::size_t>(from[0] == to[0] ? 1 : 0);
+    const bool up = to[axis] > from[axis];
+    std::sort(p.begin() + 1, p.end(), [&](const V2& a, const V2& b) { return up ? a[axis] < b[axis] : a[axis] > b[axis]; });
   }
-  std::vector<double> p{from[0], from[1]};
-  for (const auto& q : inner) p.insert(p.end(), q.begin(), q.end());
-  p.push_back(to[0]);
-  p.push_back(to[1]);
-  const KnotVector kv = kind == Kind::quadratic ? KnotVector::uniform(3, 3) : KnotVector::bezier(n);
+  p.push_back(to);
+  return p;
+}
+
+Curve make_curve(Kind kind, const Ctl& c) {
+  std::vector<double> p;
+  for (const V2& q : c) p.insert(p.end(), q.begin(), q.end());
+  const int n = static_cast<int>(c.size());
+  const KnotVector kv = kind == Kind::quadratic ? KnotVector::uniform(3, n - 2) : KnotVector::bezier(n);
   return Curve({kv}, 2, std::move(p));
 }
 
-std::vector<Curve> random_input(Rng& r, KernelOp op, Kind k, bool sorted) {
-  auto left = [&](Rng& g, Kind kk) { return random_curve(g, kk, {-1, -1}, {-1, 1}, {-2, -2}, {0, 2}, sorted); };
-  auto right = [&](Rng& g, Kind kk) { return random_curve(g, kk, {1, -1}, {1, 1}, {0, -2}, {2, 2}, sorted); };
-  auto bottom = [&](Rng& g, Kind kk) { return random_curve(g, kk, {-1, -1}, {1, -1}, {-2, -2}, {2, 0}, sorted); };
-  auto top = [&](Rng& g, Kind kk) { return random_curve(g, kk, {-1, 1}, {1, 1}, {-2, 0}, {2, 2}, sorted); };
+/// The control polygons of one random input (seed 004 Sec. 5.1), in the order the regular
+/// constructor takes the curves: Boolean sum [bottom, top, left, right]; half Boolean sum the
+/// top and the left curves, both starting at their shared corner (-1, 1); ruling [bottom, top].
+std::vector<Ctl> random_input(Rng& r, KernelOp op, Kind k, bool sorted) {
+  auto left = [&] { return random_points(r, k, {-1, -1}, {-1, 1}, {-2, -2}, {0, 2}, sorted); };
+  auto right = [&] { return random_points(r, k, {1, -1}, {1, 1}, {0, -2}, {2, 2}, sorted); };
+  auto bottom = [&] { return random_points(r, k, {-1, -1}, {1, -1}, {-2, -2}, {2, 0}, sorted); };
+  auto top = [&] { return random_points(r, k, {-1, 1}, {1, 1}, {-2, 0}, {2, 2}, sorted); };
   switch (op) {
     case KernelOp::boolean_sum: {
-      Curve b = bottom(r, k), t = top(r, k), l = left(r, k), rr = right(r, k);
+      Ctl b = bottom(), t = top(), l = left(), rr = right();
       return {b, t, l, rr};
     }
     case KernelOp::half_boolean_sum: {
-      // Left and top share (-1, 1): c1 = top (from (-1,1)), c2 = left traversed from (-1,1).
-      Curve l = left(r, k), t = top(r, k);
-      return {t, spline::reverse(l, 0)};
+      Ctl l = left(), t = top();
+      std::reverse(l.begin(), l.end());
+      return {t, l};
     }
     default: {
-      Curve b = bottom(r, k), t = top(r, k);
+      Ctl b = bottom(), t = top();
       return {b, t};
     }
   }
 }
 
-using V2 = std::array<double, 2>;
-
-double cross(const V2& a, const V2& b) { return a[0] * b[1] - a[1] * b[0]; }
-V2 sub(const V2& a, const V2& b) { return {a[0] - b[0], a[1] - b[1]}; }
+/// The corners of the boundary loop from the control polygons alone (clamped curves: the end
+/// tangents point along the first and last legs): the same verdict as screen_boundary's corner
+/// test, without building a curve. Loops as input_loop builds them.
+bool corners_ok(KernelOp op, const std::vector<Ctl>& c) {
+  struct Ends {
+    V2 start, end;  // tangent directions at the start and the end
+  };
+  auto ends = [](const Ctl& p) { return Ends{sub(p[1], p[0]), sub(p.back(), p[p.size() - 2])}; };
+  auto reversed = [](Ends e) { return Ends{{-e.end[0], -e.end[1]}, {-e.start[0], -e.start[1]}}; };
+  auto segment = [](const V2& a, const V2& b) { return Ends{sub(b, a), sub(b, a)}; };
+  std::vector<Ends> loop;
+  switch (op) {
+    case KernelOp::boolean_sum: loop = {ends(c[0]), ends(c[3]), reversed(ends(c[1])), reversed(ends(c[2]))}; break;
+    case KernelOp::half_boolean_sum: loop = {ends(c[0]), ends(c[1]), reversed(ends(c[0])), reversed(ends(c[1]))}; break;
+    default: loop = {ends(c[0]), segment(c[0].back(), c[1].back()), reversed(ends(c[1])), segment(c[1][0], c[0][0])};
+  }
+  int turn = 0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    const V2& ta = loop[(i + loop.size() - 1) % loop.size()].end;
+    const V2& tb = loop[i].start;
+    const double la = std::hypot(ta[0], ta[1]), lb = std::hypot(tb[0], tb[1]);
+    if (!(la > 0 && lb > 0)) return false;
+    const double sine = cross(ta, tb) / (la * lb);
+    const int s = sine > std::sin(M_PI / 180) ? 1 : sine < -std::sin(M_PI / 180) ? -1 : 0;
+    if (s == 0 || (turn != 0 && s != turn)) return false;
+    turn = s;
+  }
+  return true;
+}
 
 bool segments_cross(const V2& a, const V2& b, const V2& c, const V2& d) {
   const double d1 = cross(sub(b, a), sub(c, a)), d2 = cross(sub(b, a), sub(d, a));
@@ -149,17 +184,12 @@ std::vector<Curve> input_loop(KernelOp op, const std::vector<Curve>& c) {
 }
 
 /// Simple boundary and corners turning by less than 180 degrees (seed 004 Sec. 4's assumptions).
+/// Cheapest test first: the corners need only the end tangents, and the sign s for which all
+/// four turn the right way; the orientation (from the signed area) must then be s. The same
+/// verdicts as testing the corners against the orientation directly.
 const char* screen_boundary(const std::vector<Curve>& loop) {
-  // Orientation from the exact signed area (geom::planar_kernel computes it the same way).
-  double area2 = 0.0;
-  for (const Curve& c : loop)
-    for (int i = 0; i <= 64; ++i) {
-      const double t = c.domain(0)[0] + (c.domain(0)[1] - c.domain(0)[0]) * i / 64;
-      const auto d = c.eval_derivatives({t}, 1);
-      area2 += (i == 0 || i == 64 ? 0.5 : 1.0) * (d[0] * d[3] - d[1] * d[2]) * (c.domain(0)[1] - c.domain(0)[0]) / 64;
-    }
-  const double orientation = area2 > 0 ? 1.0 : -1.0;
   // Corners: the incoming tangent of curve c-1 and the outgoing one of curve c.
+  int turn = 0;  // +1: every corner turns left, -1: every corner turns right
   for (std::size_t c = 0; c < loop.size(); ++c) {
     const Curve& a = loop[(c + loop.size() - 1) % loop.size()];
     const Curve& b = loop[c];
@@ -167,22 +197,59 @@ const char* screen_boundary(const std::vector<Curve>& loop) {
     const V2 ta{da[2], da[3]}, tb{db[2], db[3]};
     const double la = std::hypot(ta[0], ta[1]), lb = std::hypot(tb[0], tb[1]);
     if (!(la > 0 && lb > 0)) return "corner";
-    const double sine = orientation * cross(ta, tb) / (la * lb);
-    if (!(sine > std::sin(M_PI / 180))) return "corner";
+    const double sine = cross(ta, tb) / (la * lb);
+    const int s = sine > std::sin(M_PI / 180) ? 1 : sine < -std::sin(M_PI / 180) ? -1 : 0;
+    if (s == 0 || (turn != 0 && s != turn)) return "corner";
+    turn = s;
   }
   const int per = 40;
   std::vector<V2> poly;
-  for (const Curve& c : loop)
+  poly.reserve(loop.size() * per);
+  double basis[16];
+  for (const Curve& c : loop) {
+    const KnotVector& kv = c.knots(0);
+    const int k = kv.order();
     for (int i = 0; i < per; ++i) {
-      const auto p = c.eval({c.domain(0)[0] + (c.domain(0)[1] - c.domain(0)[0]) * i / per});
-      poly.push_back({p[0], p[1]});
+      const double t = c.domain(0)[0] + (c.domain(0)[1] - c.domain(0)[0]) * i / per;
+      const int span = kv.find_span(t);
+      kv.basis(span, t, basis);
+      V2 p{0.0, 0.0};
+      for (int j = 0; j < k; ++j) {
+        const auto q = c.point(span - k + 1 + j);
+        p[0] += basis[j] * q[0];
+        p[1] += basis[j] * q[1];
+      }
+      poly.push_back(p);
     }
-  const std::size_t n = poly.size();
+  }
+  // Every pair of non-adjacent segments, pruned by the bounding boxes of runs of 8 segments
+  // (inclusive overlap: the same verdict as testing every pair).
+  const std::size_t n = poly.size(), run = 8, runs = (n + run - 1) / run;
+  std::vector<std::array<double, 4>> box(runs, {HUGE_VAL, HUGE_VAL, -HUGE_VAL, -HUGE_VAL});
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t j = i + 2; j < n; ++j) {
-      if (i == 0 && j == n - 1) continue;
-      if (segments_cross(poly[i], poly[i + 1], poly[j], poly[(j + 1) % n])) return "self-intersecting";
+    for (const V2& p : {poly[i], poly[(i + 1) % n]}) {
+      auto& b = box[i / run];
+      b = {std::min(b[0], p[0]), std::min(b[1], p[1]), std::max(b[2], p[0]), std::max(b[3], p[1])};
     }
+  for (std::size_t a = 0; a < runs; ++a)
+    for (std::size_t b = a; b < runs; ++b) {
+      const auto &x = box[a], &y = box[b];
+      if (x[0] > y[2] || y[0] > x[2] || x[1] > y[3] || y[1] > x[3]) continue;
+      for (std::size_t i = a * run; i < std::min(n, (a + 1) * run); ++i)
+        for (std::size_t j = std::max(i + 2, b * run); j < std::min(n, (b + 1) * run); ++j) {
+          if (i == 0 && j == n - 1) continue;
+          if (segments_cross(poly[i], poly[i + 1], poly[j], poly[(j + 1) % n])) return "self-intersecting";
+        }
+    }
+  // Orientation from the signed area (geom::planar_kernel computes it the same way, exactly).
+  double area2 = 0.0;
+  for (const Curve& c : loop)
+    for (int i = 0; i <= 64; ++i) {
+      const double t = c.domain(0)[0] + (c.domain(0)[1] - c.domain(0)[0]) * i / 64;
+      const auto d = c.eval_derivatives({t}, 1);
+      area2 += (i == 0 || i == 64 ? 0.5 : 1.0) * (d[0] * d[3] - d[1] * d[2]) * (c.domain(0)[1] - c.domain(0)[0]) / 64;
+    }
+  if ((area2 > 0 ? 1 : -1) != turn) return "corner";
   return nullptr;
 }
 
@@ -224,7 +291,9 @@ struct Candidate {
 Candidate screen(KernelOp op, Kind kind, std::uint64_t seed, int dataset, std::uint64_t index, bool sorted) {
   Rng rng{seed * 0x100000001B3ull ^ (static_cast<std::uint64_t>(dataset) << 48) ^ index * 0xD6E8FEB86659FD93ull};
   Candidate c;
-  c.curves = random_input(rng, op, kind, sorted);
+  const auto ctl = random_input(rng, op, kind, sorted);
+  if (!corners_ok(op, ctl)) return c.rejected = "corner", c;
+  for (const Ctl& p : ctl) c.curves.push_back(make_curve(kind, p));
   try {
     construct::KernelConstructOptions o;
     if (const char* why = screen_boundary(input_loop(op, c.curves))) return c.rejected = why, c;
@@ -239,36 +308,91 @@ Candidate screen(KernelOp op, Kind kind, std::uint64_t seed, int dataset, std::u
 }
 
 /// Iteration of first success (-1: none) of Alg. 1 with the given way of adding freedom.
-int run(const spline::Surface& s0, AddDof how, int max_dof) {
+int run(const spline::Surface& s0, AddDof how, int max_dof, construct::KernelPoint point) {
   construct::KernelConstructOptions o;
   o.add_dof = how;
   o.max_dof = max_dof;
+  o.kernel_point = point;
   const auto r = construct::kernel_based(s0, o);
   return r.valid ? r.iterations : -1;
+}
+
+struct Args {
+  int samples = 1000;
+  int threads = 2;
+  std::uint64_t seed = 2023;
+  std::string op = "all";
+  std::string curves = "all";
+  bool sorted = false;
+  std::string point = "both";
+};
+
+const char* usage =
+    "usage: trivox_bench_kernel_success [--samples N=1000] [--threads N=2] [--seed N=2023]\n"
+    "         [--op boolean_sum|half_boolean_sum|ruled|all] [--curves cubic|quartic|quadratic|all]\n"
+    "         [--inner unsorted|sorted] [--point centroid|fitted|both]\n"
+    "Success rates of the kernel-based constructors on the random datasets of seed 004 Sec. 5.1.\n"
+    "  --samples   samples kept per dataset (regular construction invalid, boundary with a kernel)\n"
+    "  --threads   TBB threads (the table does not depend on it)\n"
+    "  --seed      random seed of the datasets\n"
+    "  --inner     inner control points as drawn (the paper's text) or sorted along the curve\n"
+    "  --point     interior control points at the kernel centroid (Alg. 1), at the fitted point\n"
+    "              when the centroid fails (construct::KernelPoint::fitted, seed 004 Sec. 7), or both\n"
+    "The old positional form [samples] [threads] [seed] [op] [unsorted|sorted] [curves] is accepted.\n";
+
+bool parse(int argc, char** argv, Args& a) {
+  std::vector<std::string> pos;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    if (k == "--help" || k == "-h") return std::fputs(usage, stdout), std::exit(0), true;
+    if (k.rfind("--", 0) == 0) {
+      if (i + 1 >= argc) return false;
+      const std::string v = argv[++i];
+      if (k == "--samples") a.samples = std::atoi(v.c_str());
+      else if (k == "--threads") a.threads = std::atoi(v.c_str());
+      else if (k == "--seed") a.seed = std::strtoull(v.c_str(), nullptr, 10);
+      else if (k == "--op") a.op = v;
+      else if (k == "--curves") a.curves = v;
+      else if (k == "--inner") a.sorted = v == "sorted";
+      else if (k == "--point") a.point = v;
+      else return false;
+    } else {
+      pos.push_back(k);
+    }
+  }
+  if (pos.size() > 0) a.samples = std::atoi(pos[0].c_str());
+  if (pos.size() > 1) a.threads = std::atoi(pos[1].c_str());
+  if (pos.size() > 2) a.seed = std::strtoull(pos[2].c_str(), nullptr, 10);
+  if (pos.size() > 3) a.op = pos[3];
+  if (pos.size() > 4) a.sorted = pos[4] == "sorted";
+  if (pos.size() > 5) a.curves = pos[5];
+  return a.samples >= 1 && a.threads >= 1 && (a.point == "centroid" || a.point == "fitted" || a.point == "both");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int samples = argc > 1 ? std::atoi(argv[1]) : 1000;
-  const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
-  const std::uint64_t seed = argc > 3 ? std::strtoull(argv[3], nullptr, 10) : 2023;
-  const std::string only = argc > 4 ? argv[4] : "";
-  const bool sorted = argc > 5 && std::string(argv[5]) == "sorted";
-  const std::string only_kind = argc > 6 ? argv[6] : "all";
-  if (samples < 1 || threads < 1) {
-    std::fprintf(stderr, "usage: %s [samples >= 1] [threads >= 1] [seed] [op|all] [unsorted|sorted] [cubic|quartic|quadratic|all]\n",
-                 argv[0]);
+  Args args;
+  if (!parse(argc, argv, args)) {
+    std::fputs(usage, stderr);
     return 2;
   }
+  const int samples = args.samples, threads = args.threads;
+  const std::uint64_t seed = args.seed;
+  const std::string only = args.op, only_kind = args.curves;
+  const bool sorted = args.sorted;
+  std::vector<construct::KernelPoint> points;
+  if (args.point != "fitted") points.push_back(construct::KernelPoint::centroid);
+  if (args.point != "centroid") points.push_back(construct::KernelPoint::fitted);
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
   std::printf("Kernel-based constructors on seed 004 Sec. 5.1 random datasets: %d samples each, seed %llu, %d threads, "
               "inner control points %s\n",
               samples, static_cast<unsigned long long>(seed), threads, sorted ? "sorted along the curve" : "unsorted");
-  std::printf("success = det J >= 0 after moving the interior control points to the kernel centroid (Alg. 1)\n\n");
-  std::printf("%-17s %-19s %9s | %-28s | %-28s | %7s\n", "operator", "curves", "screened", "degree raising: 1st / all",
-              "refinement: 1st / all", "seconds");
-  std::printf("%-17s %-19s %9s | %-28s | %-28s |\n", "", "", "", "  trivox        paper", "  trivox        paper");
+  std::printf("success = det J >= 0 (exact: Bezier coefficients of det J, subdivision) after moving the interior control\n"
+              "points to the kernel centroid (Alg. 1; \"centroid\") or, where that fails, to the fitted point (\"fitted\")\n\n");
+  std::printf("%-17s %-19s %-8s %10s | %-28s | %-28s | %7s\n", "operator", "curves", "point", "screened",
+              "degree raising: 1st / all", "refinement: 1st / all", "seconds");
+  std::printf("%-17s %-19s %-8s %10s | %-28s | %-28s |\n", "", "", "", "", "  trivox        paper", "  trivox        paper");
   const auto t_all = Clock::now();
   int dataset = 0;
   for (KernelOp op : {KernelOp::boolean_sum, KernelOp::half_boolean_sum, KernelOp::ruled})
@@ -276,14 +400,14 @@ int main(int argc, char** argv) {
       ++dataset;
       if (!only.empty() && only != "all" && only != construct::kernel_op_name(op)) continue;
       if (only_kind != "all" && std::string(kind_name(kind)).find(only_kind) == std::string::npos) continue;
-      const auto t0 = Clock::now();
+      auto t0 = Clock::now();
       // Screen candidates in parallel batches, keep them in index order.
       std::vector<Candidate> kept;
       std::uint64_t next = 0;
-      int rejected_valid = 0, rejected_corner = 0, rejected_crossing = 0, rejected_kernel = 0;
+      long long rejected_valid = 0, rejected_corner = 0, rejected_crossing = 0, rejected_kernel = 0;
       unsigned long long examined = 0;
-      while (static_cast<int>(kept.size()) < samples && next < 50000000ull) {
-        const std::size_t batch = 512;
+      while (static_cast<int>(kept.size()) < samples && next < 2000000000ull) {
+        const std::size_t batch = 8192;
         std::vector<Candidate> cs(batch);
         tbb::parallel_for(std::size_t{0}, batch, [&](std::size_t i) { cs[i] = screen(op, kind, seed, dataset, next + i, sorted); });
         next += batch;
@@ -297,46 +421,52 @@ int main(int argc, char** argv) {
           else ++rejected_crossing;
         }
       }
+      const double screen_secs = std::chrono::duration<double>(Clock::now() - t0).count();
       const int degree = kind == Kind::cubic ? 3 : kind == Kind::quartic ? 4 : 2;
       const int max_degree = (op == KernelOp::ruled && kind == Kind::quadratic) ? 40 : 17;
       const int n = static_cast<int>(kept.size());
-      std::vector<int> elev(static_cast<std::size_t>(n)), refi(static_cast<std::size_t>(n));
-      tbb::parallel_for(0, n, [&](int i) {
-        elev[static_cast<std::size_t>(i)] = run(kept[static_cast<std::size_t>(i)].s0, AddDof::elevate, max_degree - degree);
-        refi[static_cast<std::size_t>(i)] = run(kept[static_cast<std::size_t>(i)].s0, AddDof::refine, 20);
-      });
-      auto rates = [&](const std::vector<int>& it) {
-        int first = 0, all = 0;
-        for (int v : it) first += v == 0, all += v >= 0;
-        return std::array<double, 2>{100.0 * first / std::max(1, n), 100.0 * all / std::max(1, n)};
-      };
-      const auto e = rates(elev), r = rates(refi);
-      const Paper p = paper(op, kind);
-      const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
-      char ecol[64], rcol[64];
-      std::snprintf(ecol, sizeof ecol, "%5.1f / %5.1f  %6s / %-4s", e[0], e[1], p.elevate_first, p.elevate_all);
-      std::snprintf(rcol, sizeof rcol, "%5.1f / %5.1f  %6s / %-4s", r[0], r[1], p.refine_first, p.refine_all);
-      std::printf("%-17s %-19s %9llu | %-28s | %-28s | %7.1f\n", construct::kernel_op_name(op), kind_name(kind),
-                  examined, ecol, rcol, secs);
-      // Per-iteration first successes (the paper's graphs), and why candidates were dropped.
-      auto histogram = [&](const std::vector<int>& it, int max_i) {
-        std::string h;
-        char buf[32];
-        for (int i = 0; i <= max_i; ++i) {
-          const auto k = std::count(it.begin(), it.end(), i);
-          if (k == 0) continue;
-          std::snprintf(buf, sizeof buf, " %d:%d", i, static_cast<int>(k));
+      std::printf("    kept %d; dropped: corner >= 179 degrees %lld, self-intersecting %lld, regular valid %lld, no kernel %lld "
+                  "(screening %.1f s)\n",
+                  n, rejected_corner, rejected_crossing, rejected_valid, rejected_kernel, screen_secs);
+      for (construct::KernelPoint point : points) {
+        t0 = Clock::now();
+        std::vector<int> elev(static_cast<std::size_t>(n)), refi(static_cast<std::size_t>(n));
+        tbb::parallel_for(0, 2 * n, [&](int j) {
+          const auto i = static_cast<std::size_t>(j / 2);
+          if (j % 2 == 0) elev[i] = run(kept[i].s0, AddDof::elevate, max_degree - degree, point);
+          else refi[i] = run(kept[i].s0, AddDof::refine, 20, point);
+        });
+        auto rates = [&](const std::vector<int>& it) {
+          int first = 0, all = 0;
+          for (int v : it) first += v == 0, all += v >= 0;
+          return std::array<double, 2>{100.0 * first / std::max(1, n), 100.0 * all / std::max(1, n)};
+        };
+        const auto e = rates(elev), r = rates(refi);
+        const Paper p = paper(op, kind);
+        const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
+        char ecol[64], rcol[64];
+        std::snprintf(ecol, sizeof ecol, "%5.1f / %5.1f  %6s / %-4s", e[0], e[1], p.elevate_first, p.elevate_all);
+        std::snprintf(rcol, sizeof rcol, "%5.1f / %5.1f  %6s / %-4s", r[0], r[1], p.refine_first, p.refine_all);
+        std::printf("%-17s %-19s %-8s %10llu | %-28s | %-28s | %7.1f\n", construct::kernel_op_name(op), kind_name(kind),
+                    point == construct::KernelPoint::centroid ? "centroid" : "fitted", examined, ecol, rcol, secs);
+        // Per-iteration first successes (the paper's graphs).
+        auto histogram = [&](const std::vector<int>& it, int max_i) {
+          std::string h;
+          char buf[32];
+          for (int i = 0; i <= max_i; ++i) {
+            const auto k = std::count(it.begin(), it.end(), i);
+            if (k == 0) continue;
+            std::snprintf(buf, sizeof buf, " %d:%d", i, static_cast<int>(k));
+            h.append(buf);
+          }
+          std::snprintf(buf, sizeof buf, " failed:%d", static_cast<int>(std::count(it.begin(), it.end(), -1)));
           h.append(buf);
-        }
-        std::snprintf(buf, sizeof buf, " failed:%d", static_cast<int>(std::count(it.begin(), it.end(), -1)));
-        h.append(buf);
-        return h;
-      };
-      std::printf("    kept %d; dropped: corner >= 179 degrees %d, self-intersecting %d, regular valid %d, no kernel %d\n", n,
-                  rejected_corner, rejected_crossing, rejected_valid, rejected_kernel);
-      std::printf("    raising, successes per iteration:%s\n", histogram(elev, max_degree - degree).c_str());
-      std::printf("    refining, successes per iteration:%s\n", histogram(refi, 20).c_str());
-      std::fflush(stdout);
+          return h;
+        };
+        std::printf("    raising, successes per iteration:%s\n", histogram(elev, max_degree - degree).c_str());
+        std::printf("    refining, successes per iteration:%s\n", histogram(refi, 20).c_str());
+        std::fflush(stdout);
+      }
     }
   std::printf("\ntotal %.1f s\n", std::chrono::duration<double>(Clock::now() - t_all).count());
   return 0;

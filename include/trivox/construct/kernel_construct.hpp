@@ -58,6 +58,23 @@ enum class Acceptance {
   positive,
 };
 
+/// Where the interior control points go (seed 004 Alg. 1 line 9; Sec. 7).
+enum class KernelPoint {
+  /// The centroid of the conservative kernel, at every iteration (the paper's Alg. 1).
+  centroid,
+  /// The centroid first; when S_i is not accepted there, the centroid of the part of the kernel
+  /// where det J's Bezier coefficients (pieces subdivided up to `fit_subdivisions` times where
+  /// needed) all have the boundary's sign, if that part has positive area (volume). Seed 004
+  /// Sec. 7 names "a more careful selection of the interior kernel location" as the degree of
+  /// freedom the paper did not exercise. With every interior point at K (or at K plus the fixed
+  /// Sec. 6 offsets), det J is affine in K: the cross (triple) products of the derivatives lose
+  /// every term with K twice, since K x K = 0. So each coefficient is a half-plane (half-space)
+  /// in K, and any K in their intersection gives det J >= 0 by the convex hull property. The
+  /// acceptance check is still the exact one; the point stays inside the boundary's kernel, so
+  /// Theorem 4 still applies as more freedom is added.
+  fitted,
+};
+
 struct KernelConstructOptions {
   AddDof add_dof = AddDof::refine;
   /// Largest number of knots per span (refine) or degree raisings (elevate) tried: iterations
@@ -68,6 +85,11 @@ struct KernelConstructOptions {
   /// from the control net (first to last layer per direction).
   double spread = 0.0;
   Acceptance acceptance = Acceptance::nonnegative;
+  KernelPoint kernel_point = KernelPoint::centroid;
+  /// KernelPoint::fitted: how many times a Bezier piece of det J whose coefficients can have the
+  /// wrong sign inside the kernel is halved in every direction before its coefficients become
+  /// constraints (each halving tightens them: the region only grows).
+  int fit_subdivisions = 3;
   int ruling_order = 3;             ///< order of the ruling direction (seed 004 Sec. 5.1: 3)
   geom::KernelOptions kernel{};     ///< refinement of the kernel computation
   geom::ValidityOptions validity{}; ///< subdivision limits of the validity checks
@@ -85,6 +107,10 @@ struct KernelResult {
   /// boundary has a kernel.
   std::optional<std::array<double, P>> kernel;
   double kernel_measure = 0.0;  ///< the kernel's area (P = 2) or volume (P = 3)
+  /// Where the result's interior control points were moved: the kernel centroid `kernel`, or a
+  /// fitted point (KernelPoint::fitted; then `fitted` is true). Empty when no kernel.
+  std::optional<std::array<double, P>> point;
+  bool fitted = false;
   /// The result meets options.acceptance (or the regular construction was valid).
   bool valid = false;
   /// The result is also strictly valid (geom::check_validity: det J > 0 everywhere).

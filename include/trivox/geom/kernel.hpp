@@ -98,4 +98,14 @@ std::vector<spline::Surface> oriented_boundary(const spline::Trivariate& t);
 /// spatial_kernel(oriented_boundary(t)): the kernel of a trivariate's boundary.
 SpatialKernel spatial_kernel(const spline::Trivariate& t, const KernelOptions& options = {});
 
+/// The part of a kernel polygon where further affine constraints hold: {a, b, c} keeps the
+/// points with a x + b y + c >= 0. Constraints with (a, b) = 0 keep everything when c >= 0 and
+/// nothing otherwise. The result's `constraints` counts k's and the ones given; `orientation` is
+/// k's. Used to pick the kernel point of seed 004 Alg. 1 more carefully (Sec. 7), where det J's
+/// coefficients, affine in that point, give the constraints (construct/kernel_construct.hpp).
+PlanarKernel restrict_kernel(const PlanarKernel& k, std::span<const std::array<double, 3>> constraints);
+
+/// The same for a kernel polyhedron: {a, b, c, d} keeps a x + b y + c z + d >= 0.
+SpatialKernel restrict_kernel(const SpatialKernel& k, std::span<const std::array<double, 4>> constraints);
+
 }  // namespace trivox::geom
