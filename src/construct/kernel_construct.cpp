@@ -460,6 +460,14 @@ KernelResult<P> kernel_based(const TensorSpline<P>& s0, const KernelConstructOpt
     return r;
   }
   r.kernel = k;
+  // KernelPoint::fitted takes its point from a tighter kernel (planar: cheap; trivariates keep
+  // `kernel`, as each 3-D refinement multiplies a face's constraints by four).
+  KernelOf<P> fit_kern = kern;
+  if constexpr (P == 2)
+    if (o.kernel_point == KernelPoint::fitted && o.fit_kernel.refinements > o.kernel.refinements) {
+      const auto tight = geom::planar_kernel(s0, o.fit_kernel);
+      if (!tight.empty()) fit_kern = tight;
+    }
   // Alg. 1 lines 10-20.
   const int max_dof = std::max(0, o.max_dof);
   for (int i = 0; i <= max_dof; ++i) {
@@ -470,7 +478,7 @@ KernelResult<P> kernel_based(const TensorSpline<P>& s0, const KernelConstructOpt
     r.fitted = false;
     bool ok = accepted(s, orientation, o);
     if (!ok && o.kernel_point == KernelPoint::fitted)
-      if (const auto f = fitted_point<P>(s, kern, k, o.spread * size, orientation, o.fit_subdivisions)) {
+      if (const auto f = fitted_point<P>(s, fit_kern, k, o.spread * size, orientation, o.fit_subdivisions)) {
         move_interior<P>(s, *f, o.spread * size, orientation);
         ok = accepted(s, orientation, o);
         r.point = *f;

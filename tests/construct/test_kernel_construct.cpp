@@ -307,8 +307,8 @@ TEST_CASE("KernelPoint::fitted: a kernel point where det J's coefficients allow 
   REQUIRE(r.point.has_value());
   CHECK(*r.point != *r.kernel);
   CHECK(*r.kernel == *at_centroid.kernel);  // `kernel` stays the centroid
-  // The fitted point lies inside the kernel polygon.
-  const auto kern = geom::planar_kernel(construct::regular_construct(KernelOp::boolean_sum, c));
+  // The fitted point lies inside the (tighter, still conservative) kernel it is taken from.
+  const auto kern = geom::planar_kernel(construct::regular_construct(KernelOp::boolean_sum, c), o.fit_kernel);
   for (std::size_t i = 0; i < kern.vertices.size(); ++i) {
     const auto& a = kern.vertices[i];
     const auto& b = kern.vertices[(i + 1) % kern.vertices.size()];

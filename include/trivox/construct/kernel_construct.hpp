@@ -90,6 +90,10 @@ struct KernelConstructOptions {
   /// wrong sign inside the kernel is halved in every direction before its coefficients become
   /// constraints (each halving tightens them: the region only grows).
   int fit_subdivisions = 3;
+  /// KernelPoint::fitted, planar surfaces: the kernel the fitted point is taken from, tighter
+  /// than `kernel` (still inside the true kernel: refinement only grows the conservative kernel
+  /// towards it). Trivariates use `kernel` (each 3-D refinement quadruples a face's constraints).
+  geom::KernelOptions fit_kernel{6};
   int ruling_order = 3;             ///< order of the ruling direction (seed 004 Sec. 5.1: 3)
   geom::KernelOptions kernel{};     ///< refinement of the kernel computation
   geom::ValidityOptions validity{}; ///< subdivision limits of the validity checks
