@@ -1,8 +1,9 @@
 // `trivox build SCENE -o MODEL`: expands a scene's primitives (seed 003 Sec. 3.2.3) and fields
 // into a model, writes it atomically (save_model: a temporary name, then a rename), and prints a
 // quality report: per cell the Jacobian validity bounds and the volume, per primitive the exact
-// volume against the cells' total and how closely the properties follow the field. Exit 1 when a
-// cell is not valid (the model is written all the same, so it can be inspected).
+// volume against the cells' total and how closely the properties follow the field, per fillet
+// its gap, G1 angle, det J sign and property jump (fillet/fillet.hpp). Exit 1 when a cell is not
+// valid (the model is written all the same, so it can be inspected).
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -30,6 +31,9 @@ struct Options {
 
 struct CellQuality {
   bool checked = false;  ///< false for a rational trivariate, which check_validity does not decide
+  /// A fillet's half: det J vanishes on the faces that collapse onto the rails (seed 000 Sec. 9),
+  /// so its verdict is the sign of det J inside, from the fillet's own report.
+  const fillet::FilletQuality* fillet = nullptr;
   geom::ValidityReport<3> validity;
   double volume = 0.0;
 };
@@ -44,6 +48,21 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
   double total = 0.0;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const auto& r = q[i].validity;
+    if (const auto* f = q[i].fillet) {
+      const bool ok = f->jacobian() == "positive";
+      valid = valid && ok;
+      total += q[i].volume;
+      jc.push_back({{"name", cells[i].name},
+                    {"primitive", nullptr},
+                    {"orders", cells[i].volume.orders()},
+                    {"counts", cells[i].volume.counts()},
+                    {"valid", ok},
+                    {"verdict", ok ? "fillet" : "invalid"},
+                    {"min_jacobian", f->det_min},
+                    {"max_jacobian", f->det_max},
+                    {"volume", q[i].volume}});
+      continue;
+    }
     const bool ok = r.verdict == geom::Validity::valid;
     valid = valid && (ok || !q[i].checked);
     total += q[i].volume;
@@ -75,6 +94,32 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                   {"relative_error", std::abs(v - p.exact_volume) / p.exact_volume},
                   {"field", field}});
   }
+  nlohmann::ordered_json jf = nlohmann::ordered_json::array();
+  for (const auto& f : built.fillets)
+    for (std::size_t k = 0; k < f.quality.size(); ++k) {
+      const auto& q2 = f.quality[k];
+      const auto shape = [](const fillet::SplineShape& s) {
+        return nlohmann::ordered_json{{"orders", s.orders}, {"counts", s.counts}};
+      };
+      jf.push_back({{"name", f.name},
+                    {"component", k + 1},
+                    {"cells", f.cell_names[k]},
+                    {"between", {{{"cell", f.cells[0]}, {"face", spline::face_name(f.faces[0])}},
+                                 {{"cell", f.cells[1]}, {"face", spline::face_name(f.faces[1])}}}},
+                    {"gap", q2.gap},
+                    {"g1_angle", q2.g1_angle},
+                    {"jacobian", q2.jacobian()},
+                    {"min_jacobian", q2.det_min},
+                    {"max_jacobian", q2.det_max},
+                    {"property_jump", q2.property_jump},
+                    {"composed", q2.composed},
+                    {"rail_error", q2.rail_error},
+                    {"sub1", shape(q2.sub[0])},
+                    {"sub2", shape(q2.sub[1])},
+                    {"blend", shape(q2.blend)},
+                    {"fillet", shape(q2.fillet)},
+                    {"seconds", q2.seconds}});
+    }
   return {{"scene", opt.scene},
           {"model", opt.output},
           {"units", built.model.units},
@@ -82,7 +127,8 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
           {"valid", valid},
           {"volume", total},
           {"cells", jc},
-          {"primitives", jp}};
+          {"primitives", jp},
+          {"fillets", jf}};
 }
 
 void print_human(const nlohmann::ordered_json& j) {
@@ -108,6 +154,23 @@ void print_human(const nlohmann::ordered_json& j) {
                   p["type"].get<std::string>().c_str(), p["cells"].get<int>(),
                   fmt(p["exact_volume"].get<double>(), 10).c_str(), fmt(p["volume"].get<double>(), 10).c_str(),
                   fmt(p["relative_error"].get<double>(), 3).c_str(), field.c_str());
+    }
+  }
+  if (!j["fillets"].empty()) {
+    std::printf("\n%-14s %-12s %-22s %11s %11s %11s %-9s %11s %8s\n", "fillet", "cells", "between", "gap", "G1 (rad)",
+                "prop. jump", "det J", "S^ method", "seconds");
+    for (const auto& f : j["fillets"]) {
+      const auto& b = f["between"];
+      const std::string between = b[0]["cell"].get<std::string>() + "." + b[0]["face"].get<std::string>() + "/" +
+                                  b[1]["cell"].get<std::string>() + "." + b[1]["face"].get<std::string>();
+      const auto mx = [&](const char* key) { return std::max(f[key][0].get<double>(), f[key][1].get<double>()); };
+      const bool c0 = f["composed"][0].get<bool>(), c1 = f["composed"][1].get<bool>();
+      std::printf("%-14s %-12s %-22s %11s %11s %11s %-9s %11s %8s\n",
+                  (f["name"].get<std::string>() + "." + std::to_string(f["component"].get<int>())).c_str(),
+                  (f["cells"][0].get<std::string>() + "," + f["cells"][1].get<std::string>()).c_str(), between.c_str(),
+                  fmt(mx("gap"), 3).c_str(), fmt(mx("g1_angle"), 3).c_str(), fmt(mx("property_jump"), 3).c_str(),
+                  f["jacobian"].get<std::string>().c_str(), c0 && c1 ? "composed" : (c0 || c1 ? "mixed" : "fitted"),
+                  fmt(f["seconds"].get<double>(), 3).c_str());
     }
   }
   std::printf("\ntotal volume %s; %s\n", fmt(j["volume"].get<double>(), 12).c_str(),
@@ -137,12 +200,18 @@ void add_build(CLI::App& app, Common& common) {
       for (int i = 0; i < p.cell_count; ++i)
         geometry[static_cast<std::size_t>(p.first_cell + i)] = &p.geometry[static_cast<std::size_t>(i)];
     std::vector<CellQuality> q(geometry.size());
+    for (const auto& f : built.fillets)
+      for (std::size_t k = 0; k < f.cell_names.size(); ++k)
+        for (const auto& name : f.cell_names[k])
+          for (std::size_t i = 0; i < built.model.cells.size(); ++i)
+            if (built.model.cells[i].name == name) q[i].fillet = &f.quality[k];
     tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
+      q[i].volume = geom::volume(*geometry[i]);
+      if (q[i].fillet) return;
       // Rational trivariate cells have no Bezier-bound verdict (geom/validity.hpp): reported
       // as unchecked, not as invalid.
       q[i].checked = !geometry[i]->rational();
       if (q[i].checked) q[i].validity = geom::check_validity(*geometry[i]);
-      q[i].volume = geom::volume(*geometry[i]);
     });
     // Pieces of Booleans: the volume of the part their trimming admits (slice/trim.hpp).
     bool trimmed = false;

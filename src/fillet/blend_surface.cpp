@@ -89,8 +89,8 @@ KnotVector halved(const KnotVector& k) {
   return KnotVector(k.order(), all);
 }
 
-/// A field along t in R^3 interpolated as a cubic at the Greville points of knots on the rails'
-/// breakpoints, halved until `error(t, value)` (an angle) is within tolerance between samples.
+/// A field along t in R^3 interpolated at the Greville points of `start`, its spans halved until
+/// `error(t, value)` (angles) is within tolerance between the samples.
 Curve fit_field(const std::function<Vec(double)>& exact, const std::function<std::array<double, 2>(double, const Vec&)>& error,
                 const KnotVector& start, const BlendOptions& o, BlendReport& rep) {
   KnotVector k = start;
@@ -159,7 +159,10 @@ Surface blending_surface(const BlendInput& in, const BlendOptions& o, BlendRepor
 
   const std::array<Curve, 2> rail{xyz_of(in.rail[0]), xyz_of(in.rail[1])};
   const Curve center = xyz_of(in.center);
-  const KnotVector start = cubic_on(in.rail_uv[0].knots(0).breakpoints());
+  // The field is interpolated in the rails' own space (for composed sub-regions a high degree on
+  // the rails' breakpoints, dense enough as it is), so S_b's space along t is the rails' space
+  // and needs no union of knots; where that is a cubic on few spans, halving refines it.
+  const KnotVector start = rail[0].knots(0).order() >= 4 ? rail[0].knots(0) : cubic_on(rail[0].knots(0).breakpoints());
   BlendReport rep;
   std::vector<Curve> rows;
   KnotVector across;

@@ -6,6 +6,8 @@
 #include "json_io.hpp"
 
 #include "trivox/error.hpp"
+#include "trivox/geom/surface_intersection.hpp"
+#include "trivox/spline/extract.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/slice/trim.hpp"
 #include "trivox/vmodel/boolean.hpp"
@@ -199,6 +201,90 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
   return out;
 }
 
+/// {"op": "fillet", ...}: see scene.hpp.
+void read_fillet(const Source& src, const json& item, const std::string& ip, SceneOperation& o) {
+  const std::string what =
+      "a fillet {\"op\": \"fillet\", \"between\": [A, B], \"distance\", \"tau\", \"section\", \"dip\", "
+      "\"method\", \"blend\", \"flip\", \"name\"}";
+  const std::string bp = child(ip, "between");
+  const json& between = require(src, item, ip, "between", what);
+  const std::string bwhat = "two cells: names or {\"cell\": NAME, \"face\": \"u0\"..\"w1\"}";
+  if (!between.is_array() || between.size() != 2) fail_type(src, bp, between, bwhat);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::string ep = child(bp, i);
+    const json& e = between[i];
+    if (e.is_string()) {
+      o.between[i] = e.get<std::string>();
+    } else if (e.is_object()) {
+      o.between[i] = read_string(src, require(src, e, ep, "cell", bwhat), child(ep, "cell"), "a cell name");
+      const std::string face =
+          read_string(src, require(src, e, ep, "face", bwhat), child(ep, "face"), "a face name u0 u1 v0 v1 w0 w1");
+      try {
+        o.faces[i] = spline::face_from_name(face);
+      } catch (const Error&) {
+        src.fail(child(ep, "face"), "unknown face " + quote(face) + "; expected u0, u1, v0, v1, w0 or w1");
+      }
+    } else {
+      fail_type(src, ep, e, bwhat);
+    }
+    if (o.between[i].empty()) src.fail(ep, "empty cell name; expected " + bwhat);
+  }
+  if (o.between[0] == o.between[1]) src.fail(child(bp, 1), quote(o.between[1]) + " twice; expected two different cells");
+  fillet::FilletOptions& f = o.fillet;
+  const json& d = require(src, item, ip, "distance", what);
+  const std::string dp = child(ip, "distance");
+  if (d.is_array()) {
+    if (d.size() != 2) fail_type(src, dp, d, "a distance or two [d1, d2]");
+    f.distance = {read_number_at(src, d[0], dp, 0), read_number_at(src, d[1], dp, 1)};
+  } else {
+    f.distance[0] = f.distance[1] = read_number(src, d, dp);
+  }
+  for (double x : f.distance)
+    if (!(x > 0.0)) src.fail(dp, "distance " + format_double(x) + "; expected positive distances (model units)");
+  if (const json* t = find(item, "tau")) {
+    f.blend.tau = read_number(src, *t, child(ip, "tau"));
+    if (!(f.blend.tau > 0.0 && f.blend.tau <= 10.0))
+      src.fail(child(ip, "tau"), "tau " + format_double(f.blend.tau) + "; expected a value in (0, 10]");
+  }
+  if (const json* t = find(item, "section")) {
+    const std::string sec = read_string(src, *t, child(ip, "section"), "\"hermite\" or \"flend\"");
+    if (!fillet::section_from_name(sec.c_str(), f.blend.section))
+      src.fail(child(ip, "section"), "unknown section " + quote(sec) + "; expected \"hermite\" or \"flend\"");
+  }
+  if (const json* t = find(item, "dip")) {
+    f.blend.dip = read_number(src, *t, child(ip, "dip"));
+    if (!(f.blend.dip >= 0.0 && f.blend.dip <= 1.0))
+      src.fail(child(ip, "dip"), "dip " + format_double(f.blend.dip) + "; expected a value in [0, 1]");
+  }
+  if (const json* t = find(item, "method")) {
+    const std::string m = read_string(src, *t, child(ip, "method"), "\"auto\", \"compose\" or \"fit\"");
+    if (!fillet::subregion_method_from_name(m.c_str(), f.method))
+      src.fail(child(ip, "method"), "unknown method " + quote(m) + "; expected \"auto\", \"compose\" or \"fit\"");
+  }
+  if (const json* t = find(item, "blend")) {
+    const std::string b = read_string(src, *t, child(ip, "blend"), "\"parametric\"");
+    if (b == "shepard")
+      src.fail(child(ip, "blend"), "\"shepard\" is not supported yet (Euclidean-distance blends are later work); "
+                                   "expected \"parametric\"");
+    if (b != "parametric") src.fail(child(ip, "blend"), "unknown blend " + quote(b) + "; expected \"parametric\"");
+  }
+  if (const json* t = find(item, "flip")) {
+    const std::string fp = child(ip, "flip");
+    if (t->is_boolean()) {
+      f.flip[0] = f.flip[1] = t->get<bool>();
+    } else if (t->is_array() && t->size() == 2 && (*t)[0].is_boolean() && (*t)[1].is_boolean()) {
+      f.flip = {(*t)[0].get<bool>(), (*t)[1].get<bool>()};
+    } else {
+      fail_type(src, fp, *t, "true, false or [bool, bool]");
+    }
+  }
+  o.name = "fillet";
+  if (const json* n = find(item, "name")) {
+    o.name = read_string(src, *n, child(ip, "name"), "a non-empty result name");
+    if (o.name.empty()) src.fail(child(ip, "name"), "empty name; expected a non-empty result name");
+  }
+}
+
 std::vector<SceneOperation> read_operations(const Source& src, const json& root) {
   const json* j = find(root, "operations");
   if (j == nullptr) return {};
@@ -237,15 +323,114 @@ std::vector<SceneOperation> read_operations(const Source& src, const json& root)
           src.fail(child(ip, "power"), "power " + format_double(o.power) + "; expected a power in (0, 64]");
       }
     }
+    if (op == "fillet") read_fillet(src, item, ip, o);
     out.push_back(std::move(o));
   }
   return out;
 }
 
-/// The scene's Boolean operations, in order, on named objects: each scene cell (a primitive's
-/// cells together) is an object; an operation replaces its operands by its result, placed where
-/// `a` was. The primitives' reports keep only the primitives no operation consumed.
-void apply_booleans(const Scene& scene, const Source& src, SceneBuild& out) {
+/// A model cell by name: a cell of any object, or an object of one cell.
+template <class Objects>
+const vmodel::VCell& find_cell(const Source& src, const Objects& objects, const std::string& name, const std::string& ptr) {
+  for (const auto& o : objects) {
+    for (const auto& c : o.cells)
+      if (c.name == name) return c;
+    if (o.name == name && o.cells.size() == 1) return o.cells.front();
+    if (o.name == name)
+      src.fail(ptr, quote(name) + " has " + std::to_string(o.cells.size()) +
+                        " cells; expected one cell: name it (" + quote(o.cells.front().name) + ", ...)");
+  }
+  src.fail(ptr, "no cell named " + quote(name) + "; expected the name of a model cell (a primitive's cells are "
+                "<name>.<part>)");
+}
+
+/// Seed 000 Alg. 2 between two cells: the faces (given, or the one intersecting pair), the
+/// fillets, their cells named <name>.<k>a and <name>.<k>b.
+template <class Objects>
+std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation& op,
+                                        const Objects& objects, SceneBuild& out) {
+  std::array<const vmodel::VCell*, 2> cell{};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const std::string ptr = op.pointer + "/between/" + std::to_string(i);
+    cell[i] = &find_cell(src, objects, op.between[i], ptr);
+    if (!cell[i]->plain())
+      src.fail(ptr, quote(op.between[i]) + " is a trimmed piece of a Boolean; expected a plain cell (fillets of "
+                    "trimmed cells are later work)");
+    if (cell[i]->volume.rational())
+      src.fail(ptr, quote(op.between[i]) + " is rational; expected a polynomial cell");
+  }
+  std::array<spline::Face, 2> faces{};
+  if (op.faces[0] && op.faces[1]) {
+    faces = {*op.faces[0], *op.faces[1]};
+  } else {
+    // The pairs of faces that cross along a curve.
+    geom::IntersectionOptions io;
+    const auto b0 = spline::bounding_box(cell[0]->volume, 3), b1 = spline::bounding_box(cell[1]->volume, 3);
+    double diag = 0.0;
+    for (std::size_t j = 0; j < 3; ++j) {
+      const double e = std::max(b0[1][j], b1[1][j]) - std::min(b0[0][j], b1[0][j]);
+      diag += e * e;
+    }
+    io.tolerance = 1e-7 * std::sqrt(diag);
+    std::vector<std::array<spline::Face, 2>> hits;
+    for (spline::Face f0 : spline::all_faces) {
+      if (op.faces[0] && f0 != *op.faces[0]) continue;
+      const spline::Surface s0 = spline::boundary_face(cell[0]->volume, f0);
+      for (spline::Face f1 : spline::all_faces) {
+        if (op.faces[1] && f1 != *op.faces[1]) continue;
+        const auto curves = geom::intersect_surfaces(s0, spline::boundary_face(cell[1]->volume, f1), io);
+        const bool curve = std::any_of(curves.begin(), curves.end(), [](const auto& c) { return c.points.size() > 1; });
+        if (curve) hits.push_back({f0, f1});
+      }
+    }
+    const std::string names = quote(op.between[0]) + " and " + quote(op.between[1]);
+    if (hits.empty())
+      src.fail(op.pointer + "/between", "the faces of " + names + " do not intersect; expected cells whose "
+                                        "boundaries cross along a curve");
+    if (hits.size() > 1) {
+      std::string list;
+      for (const auto& h : hits)
+        list += (list.empty() ? "" : ", ") + std::string(spline::face_name(h[0])) + "/" + std::string(spline::face_name(h[1]));
+      src.fail(op.pointer + "/between", names + " intersect on several pairs of faces (" + list +
+                                            "); expected one: choose the faces with {\"cell\", \"face\"} (fillets "
+                                            "across several faces are later work)");
+    }
+    faces = hits.front();
+  }
+  std::vector<fillet::Fillet> fillets;
+  try {
+    fillets = fillet::fillet_faces(cell[0]->volume, faces[0], cell[1]->volume, faces[1], op.fillet);
+  } catch (const Error& e) {
+    throw e.within(src.at(op.pointer));
+  }
+  FilletBuild rep;
+  rep.name = op.name;
+  rep.pointer = op.pointer;
+  rep.cells = op.between;
+  rep.faces = faces;
+  std::vector<vmodel::VCell> cells;
+  for (std::size_t k = 0; k < fillets.size(); ++k) {
+    const auto& q = fillets[k].quality;
+    if (q.jacobian() == "changes sign")
+      throw Error(src.at(op.pointer) + ": fillet " + std::to_string(k + 1) + " of " + quote(op.name) +
+                      ": det J changes sign inside (from " + format_double(q.det_min) + " to " +
+                      format_double(q.det_max) + "); expected a valid fillet: try other distances or tau",
+                  ErrorKind::failed);
+    const std::string base = op.name + "." + std::to_string(k + 1);
+    rep.cell_names.push_back({base + "a", base + "b"});
+    rep.quality.push_back(q);
+    cells.emplace_back(base + "a", fillets[k].halves[0]);
+    cells.emplace_back(base + "b", fillets[k].halves[1]);
+  }
+  out.fillets.push_back(std::move(rep));
+  return cells;
+}
+
+/// The scene's Boolean and fillet operations, in order, on named objects: each scene cell (a
+/// primitive's cells together) is an object; a Boolean replaces its operands by its result,
+/// placed where `a` was; a fillet appends its cells as a new object. The primitives' reports keep
+/// only the primitives no Boolean consumed.
+void apply_operations(const Scene& scene, const Source& src, SceneBuild& out) {
   struct Object {
     std::string name;
     std::vector<vmodel::VCell> cells;
@@ -269,6 +454,13 @@ void apply_booleans(const Scene& scene, const Source& src, SceneBuild& out) {
     return std::find_if(objects.begin(), objects.end(), [&](const Object& o) { return o.name == name; });
   };
   for (const SceneOperation& op : scene.operations) {
+    if (op.op == "fillet") {
+      if (find_object(op.name) != objects.end())
+        src.fail(op.pointer + "/name", quote(op.name) + " names another cell or result; expected a fresh name");
+      Object result{op.name, apply_fillet(src, op, objects, out), -1};
+      objects.push_back(std::move(result));
+      continue;
+    }
     const auto ia = find_object(op.a);
     if (ia == objects.end())
       src.fail(op.pointer + "/a", "no cell or result named " + quote(op.a) + "; expected the name of a scene cell or of an earlier operation's result");
@@ -348,12 +540,12 @@ SceneBuild build_scene(const Scene& scene) {
   const Source src{scene.source};
   for (const SceneOperation& op : scene.operations) {
     const bool boolean = op.op == "union" || op.op == "intersection" || op.op == "subtraction";
-    if (boolean) continue;
+    if (boolean || op.op == "fillet") continue;
     src.fail(op.pointer + "/op",
              quote(op.op) + " is not supported yet (" +
-                 (op.op == "fillet" ? std::string("trivariate fillets") : std::string("constructor operations in scenes")) +
+                 std::string("constructor operations in scenes") +
                  " are later work; `trivox construct` runs one constructor on its own); expected union, "
-                 "intersection or subtraction");
+                 "intersection, subtraction or fillet");
   }
   SceneBuild out;
   out.model.units = scene.units;
@@ -395,7 +587,7 @@ SceneBuild build_scene(const Scene& scene) {
     }
     out.primitives.push_back(std::move(report));
   }
-  if (!scene.operations.empty()) apply_booleans(scene, src, out);
+  if (!scene.operations.empty()) apply_operations(scene, src, out);
   return out;
 }
 

@@ -121,12 +121,61 @@ Eigen::MatrixXd transfer_matrix(const KnotVector& from, const KnotVector& to) {
   if (to.order() < from.order())
     throw Error("order " + std::to_string(to.order()) + " cannot hold order " + std::to_string(from.order()) +
                 "; expected a target order >= the source order");
-  const auto samples = span_samples(to, to.order());
-  const Eigen::MatrixXd A_to = collocation(to, samples);
-  const Eigen::MatrixXd A_from = collocation(from, samples);
-  const Eigen::MatrixXd T = A_to.colPivHouseholderQr().solve(A_from);
-  // The system is consistent exactly when `to` contains `from`.
-  const double residual = (A_to * T - A_from).cwiseAbs().maxCoeff();
+  // Column j of T expresses the source's basis function B_j in the target basis. B_j vanishes
+  // outside its support [a, b], and so (local linear independence of B-splines) it is a
+  // combination of the target functions whose supports lie in [a, b]: a small collocation
+  // system on the target's spans inside [a, b], one per source function. Cost O(n_from *
+  // (local size)^3) instead of a dense solve of the whole space.
+  const int nf = from.size(), nt = to.size(), kf = from.order(), kt = to.order();
+  const auto& tf = from.knots();
+  const auto& tt = to.knots();
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(nt, nf);
+  std::vector<double> N(static_cast<std::size_t>(std::max(kf, kt)));
+  const double eps = 1e-13 * (to.back() - to.front());
+  double residual = 0.0;
+  for (int j = 0; j < nf; ++j) {
+    const double a = std::max(tf[static_cast<std::size_t>(j)], from.front());
+    const double b = std::min(tf[static_cast<std::size_t>(j + kf)], from.back());
+    if (!(a < b)) continue;
+    // Target functions i with a <= t_i and t_{i+kt} <= b; target spans inside [a, b].
+    int i0 = 0;
+    while (i0 < nt && tt[static_cast<std::size_t>(i0)] < a - eps) ++i0;
+    int i1 = nt - 1;
+    while (i1 >= 0 && tt[static_cast<std::size_t>(i1 + kt)] > b + eps) --i1;
+    std::vector<double> samples;
+    for (int mu = kt - 1; mu < nt; ++mu) {
+      const double lo = tt[static_cast<std::size_t>(mu)], hi = tt[static_cast<std::size_t>(mu) + 1];
+      if (!(lo < hi) || lo < a - eps || hi > b + eps) continue;
+      for (int r = 0; r < kt; ++r) {
+        const double x = std::cos(std::numbers::pi * (2.0 * r + 1.0) / (2.0 * kt));
+        samples.push_back(0.5 * (lo + hi) + 0.5 * (hi - lo) * x);
+      }
+    }
+    const int cols = i1 - i0 + 1;
+    if (cols <= 0 || samples.empty()) {
+      residual = 1.0;  // no target function fits inside B_j's support: not a refinement
+      break;
+    }
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(samples.size()), cols);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(samples.size()));
+    for (std::size_t r = 0; r < samples.size(); ++r) {
+      const double x = samples[r];
+      const int mt = to.find_span(x);
+      to.basis(mt, x, N.data());
+      for (int c = 0; c < kt; ++c) {
+        const int i = mt - kt + 1 + c;
+        if (i >= i0 && i <= i1) A(static_cast<Eigen::Index>(r), i - i0) = N[static_cast<std::size_t>(c)];
+      }
+      const int mf = from.find_span(x);
+      from.basis(mf, x, N.data());
+      const int c = j - (mf - kf + 1);
+      if (c >= 0 && c < kf) rhs(static_cast<Eigen::Index>(r)) = N[static_cast<std::size_t>(c)];
+    }
+    const Eigen::VectorXd x = A.colPivHouseholderQr().solve(rhs);
+    residual = std::max(residual, (A * x - rhs).cwiseAbs().maxCoeff());
+    T.block(i0, j, cols, 1) = x;
+  }
+  // The systems are consistent exactly when `to` contains `from`.
   if (!(residual < 1e-9))
     throw Error("the target function space does not contain the source (collocation residual " +
                 std::to_string(residual) + "); expected a refinement or elevation of the source knots");

@@ -72,7 +72,7 @@ expect_fail '/cells/0: missing "field"' "$trivox" build "$tmp/s.json" -o "$tmp/x
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "ruled"}'
 expect_fail '/operations/0/op: "ruled" is not supported yet' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "fillet"}'
-expect_fail '/operations/0/op: "fillet" is not supported yet' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
+expect_fail '/operations/0: missing "between"; expected a fillet' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "smooth"}'
 expect_fail '/operations/0/op: unknown operation "smooth"; expected one of "union", "intersection"' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 [ ! -e "$tmp/x.json" ]

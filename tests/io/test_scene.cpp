@@ -126,9 +126,10 @@ TEST_CASE("scene: malformed scenes name the file, the place and what was expecte
                  "\"subtraction\", \"fillet\", \"ruled\", \"extrude\", \"revolve\", \"boolean_sum\", \"half_boolean_sum\", \"sweep\""});
 }
 
-TEST_CASE("scene: fillets and constructor operations are not built yet; expanded names must stay unique", "[scene]") {
-  // union, intersection and subtraction are built (tests/cli/booleans.sh); the others not yet.
-  for (const char* op : {"fillet", "ruled", "extrude", "revolve", "boolean_sum", "half_boolean_sum", "sweep"}) {
+TEST_CASE("scene: constructor operations are not built yet; expanded names must stay unique", "[scene]") {
+  // union, intersection, subtraction (tests/cli/booleans.sh) and fillet (tests/cli/fillet.sh)
+  // are built; the constructors not yet.
+  for (const char* op : {"ruled", "extrude", "revolve", "boolean_sum", "half_boolean_sum", "sweep"}) {
     INFO(op);
     check_message(build_error(scene(ball, std::string(R"({"op": ")") + op + "\"}")),
                   {"s.json: /operations/0/op: \"" + std::string(op) + "\" is not supported yet", "expected"});
@@ -138,4 +139,34 @@ TEST_CASE("scene: fillets and constructor operations are not built yet; expanded
     "points": [[0,0,0,1], [1,0,0,1], [0,1,0,1], [1,1,0,1], [0,0,1,1], [1,0,1,1], [0,1,1,1], [1,1,1,1]]}})";
   check_message(build_error(scene(clash + "," + ball)),
                 {"s.json: /cells/1/name: cell \"ball.core\" (from \"ball\") is also a cell of /cells/0; expected unique cell names"});
+}
+
+TEST_CASE("scene: fillet parameters are checked where they are written", "[scene][fillet]") {
+  const std::string two = ball + R"(, {"name": "box", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]},
+    "field": {"constant": 1}})";
+  const auto op = [&](const std::string& fields) { return scene(two, R"({"op": "fillet", )" + fields + "}"); };
+  const std::string between = R"("between": ["ball.x1", "box"], )";
+  check_message(build_error(op(R"("distance": 1)")), {"s.json: /operations/0: missing \"between\""});
+  check_message(build_error(op(R"("between": ["box"], "distance": 1)")),
+                {"s.json: /operations/0/between: found an array of 1", "expected two cells"});
+  check_message(build_error(op(R"("between": ["box", "box"], "distance": 1)")),
+                {"/operations/0/between/1: \"box\" twice"});
+  check_message(build_error(op(R"("between": [{"cell": "box", "face": "w2"}, "ball.x1"], "distance": 1)")),
+                {"/operations/0/between/0/face: unknown face \"w2\"; expected u0, u1, v0, v1, w0 or w1"});
+  check_message(build_error(op(between + R"("distance": [1, -2])")),
+                {"/operations/0/distance: distance -2.0; expected positive distances"});
+  check_message(build_error(op(between + R"("distance": 1, "tau": 0)")), {"/operations/0/tau: tau 0.0; expected a value in (0, 10]"});
+  check_message(build_error(op(between + R"("distance": 1, "dip": 2)")), {"/operations/0/dip: dip 2.0; expected a value in [0, 1]"});
+  check_message(build_error(op(between + R"("distance": 1, "section": "round")")),
+                {"/operations/0/section: unknown section \"round\"; expected \"hermite\" or \"flend\""});
+  check_message(build_error(op(between + R"("distance": 1, "method": "exact")")),
+                {"/operations/0/method: unknown method \"exact\"; expected \"auto\", \"compose\" or \"fit\""});
+  check_message(build_error(op(between + R"("distance": 1, "blend": "shepard")")),
+                {"/operations/0/blend: \"shepard\" is not supported yet"});
+  check_message(build_error(op(between + R"("distance": 1, "flip": "yes")")),
+                {"/operations/0/flip: found", "expected true, false or [bool, bool]"});
+  check_message(build_error(op(R"("between": ["ball.x9", "box"], "distance": 1)")),
+                {"/operations/0/between/0: no cell named \"ball.x9\""});
+  check_message(build_error(op(R"("between": ["ball", "box"], "distance": 1)")),
+                {"/operations/0/between/0: \"ball\" has 7 cells; expected one cell"});
 }

@@ -11,9 +11,9 @@
 ///   tau |C_1(t) - C_2(t)| (so tau is relative to the width of the fillet; about 1.17 follows a
 ///   circular arc across a right-angled corner with equal distances), oriented so T_1 points from
 ///   rail 1 towards C and T_2 from C towards rail 2. Normalisation is not polynomial: the field
-///   is interpolated as a cubic spline (the approximation Sec. 1.3 calls for, after Kim & Elber
-///   1997), its knots halved until the field leaves the tangent plane by at most the angle
-///   tolerance between the samples.
+///   is interpolated in the rails' function space (the approximation Sec. 1.3 calls for, after
+///   Kim & Elber 1997; at least cubic), its knots halved until the field leaves the tangent
+///   plane by at most the angle tolerance between the samples.
 /// - Flend: per t, P_I is the intersection of the tangent plane of S_1 at C_1(t), that of S_2 at
 ///   C_2(t) and C's normal plane at C(t); the section is the clamped uniform cubic B-spline with
 ///   control points P_0 = C_1, P_1 = P_0 + dip (P_I - P_0), P_2 = (P* + P**) / 2 with P* = P_1 +

@@ -16,7 +16,13 @@
 /// "a": NAME, "b": NAME, "name": RESULT (default: a), "blend": "sum_clip" | "mean" | "first" |
 /// "distance", "power": k}, where a and b name scene cells (a primitive's cells all together) or
 /// earlier results; the operation consumes a and b and puts its result, untrimmed
-/// (slice::untrim), where a was. The other operations are later work: build_scene refuses them,
+/// (slice::untrim), where a was. Fillets (fillet/fillet.hpp: seed 000 Alg. 2 with Sec. 7.1):
+/// {"op": "fillet", "between": [A, B], "distance": d | [d1, d2], "tau", "section": "hermite" |
+/// "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric", "flip": bool |
+/// [bool, bool], "name"}, A and B cell names or {"cell": NAME, "face": "u0".."w1"}; without
+/// faces, the one pair of faces that intersects is used. The fillet's cells, two per
+/// intersection component (`<name>.<k>a`, `<name>.<k>b`), are appended to the model; the
+/// filleted cells stay as they are. The constructors are later work: build_scene refuses them,
 /// naming them ("not supported yet"). An unknown name is refused by the reader, which lists the
 /// known ones.
 ///
@@ -31,6 +37,7 @@
 #include <vector>
 
 #include "trivox/construct/primitives.hpp"
+#include "trivox/fillet/fillet.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
 namespace trivox::io {
@@ -61,6 +68,11 @@ struct SceneOperation {
   std::string name;     ///< the result's name (a when not given)
   vmodel::BlendRule blend = vmodel::BlendRule::sum_clip;
   double power = 1.0;
+  // Fillets: the two cells (model cell names, or a scene cell of one cell) and, when chosen,
+  // their faces; the fillet's parameters. The result is `name` (default "fillet").
+  std::array<std::string, 2> between;
+  std::array<std::optional<spline::Face>, 2> faces;
+  fillet::FilletOptions fillet;
 };
 
 struct Scene {
@@ -93,9 +105,20 @@ struct PrimitiveBuild {
   std::vector<spline::Trivariate> geometry;
 };
 
+/// What one fillet operation gave: per intersection component, a fillet of two cells.
+struct FilletBuild {
+  std::string name;      ///< the operation's result name
+  std::string pointer;   ///< "/operations/<i>"
+  std::array<std::string, 2> cells;  ///< the filleted cells
+  std::array<spline::Face, 2> faces{};
+  std::vector<std::array<std::string, 2>> cell_names;  ///< per component: its two cells in the model
+  std::vector<fillet::FilletQuality> quality;          ///< per component
+};
+
 struct SceneBuild {
   vmodel::VModel model;
   std::vector<PrimitiveBuild> primitives;
+  std::vector<FilletBuild> fillets;
 };
 
 /// Expands the primitives (named `<name>.<part>`, construct/primitives.hpp) and applies their
