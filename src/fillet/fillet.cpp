@@ -179,7 +179,7 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
     const RailPair rp = offset_rails(s1, s2, outward, curve, o.distance, ro);
     SubregionOptions so;
     so.method = o.method;
-    so.tolerance = std::max(tol, 1e-6 * diagonal(cell1, cell2));
+    so.tolerance = tol;
     Fillet f;
     SubregionReport r1, r2;
     const Surface sub1 = subregion(s1, rp.rails[0].rail, rp.rails[0].base, so, &r1);

@@ -19,7 +19,7 @@ namespace trivox::slice {
 
 namespace {
 
-constexpr int max_order = 16;
+constexpr int max_order = 32;  // fillets composed from bicubic faces have order 19
 constexpr double inf = std::numeric_limits<double>::infinity();
 
 // ---------------------------------------------------------------------------------------------

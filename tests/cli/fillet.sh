@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# End-to-end: the scene operation "fillet" (seed 000 Alg. 2, Sec. 7.1; Flends Sec. II) built by
+# `trivox build` and seen by `trivox locate`. Truths: between a floor z <= 0 and a wall x <= 2
+# (boxes, faces chosen), the dip-0 flend is the chamfer, a prism of volume d1 d2 / 2 times the
+# length 4; the Hermite fillet's volume is 4 times the area its section (a cubic with known
+# control points) cuts from the corner, by Green's theorem in numpy; both meet the faces with no
+# gap, G1 below 1e-6 rad, det J > 0 inside, and carry each box's colour on its face. Points just
+# inside and outside the chamfer plane are in and out of the fillet. The shipped models build.
+# Bad fillets exit 2 naming the operation and what is wrong.
+set -euo pipefail
+trivox=$1
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+source tests/cli/lib.bash
+
+corner() {  # corner FILLET-FIELDS: floor [0,4]x[0,4]x[-1,0] red, wall [1,2]x[-0.5,4.5]x[-0.5,3] blue
+  cat > "$tmp/corner.json" <<EOF
+{ "trivox": 1, "units": "mm", "properties": ["r", "g", "b"],
+  "cells": [
+    {"name": "floor", "primitive": {"type": "box", "min": [0, 0, -1], "max": [4, 4, 0]}, "field": {"constant": [1, 0, 0]}},
+    {"name": "wall", "primitive": {"type": "box", "min": [1, -0.5, -0.5], "max": [2, 4.5, 3]}, "field": {"constant": [0, 0, 1]}}
+  ],
+  "operations": [{"op": "fillet", "between": [{"cell": "floor", "face": "w1"}, {"cell": "wall", "face": "u1"}], $1}] }
+EOF
+}
+
+check() {  # check BUILD-JSON KIND: the quality report and the fillet's volume
+  "$py" - "$1" "$2" <<'PY'
+import sys, json
+import numpy as np
+r = json.load(open(sys.argv[1]))
+kind = sys.argv[2]
+d1, d2, length = 1.0, 0.5, 4.0
+(f,) = r["fillets"]
+assert f["cells"] == ["fillet.1a", "fillet.1b"], f["cells"]
+assert f["between"] == [{"cell": "floor", "face": "w1"}, {"cell": "wall", "face": "u1"}], f["between"]
+assert max(f["gap"]) < 1e-12, f["gap"]
+assert max(f["property_jump"]) < 1e-12, f["property_jump"]
+assert f["jacobian"] == "positive" and f["min_jacobian"] > 0, f
+assert f["composed"] == [True, True], f["composed"]
+vol = sum(c["volume"] for c in r["cells"] if c["name"].startswith("fillet."))
+if kind == "chamfer":
+    exact = d1 * d2 / 2 * length
+else:
+    assert max(f["g1_angle"]) < 1e-6, f["g1_angle"]
+    tau = 1.2
+    w = tau * np.hypot(d1, d2)
+    # Section in (X, Z) = (x - 2, z): cubic Bezier with control points C1, C1 + T1/3, C2 - T2/3, C2.
+    P = np.array([[d1, 0], [d1 - w / 3, 0], [0, d2 - w / 3], [0, d2]])
+    v, wts = np.polynomial.legendre.leggauss(8)
+    v = 0.5 * (v + 1)
+    B = np.array([(1 - v) ** 3, 3 * v * (1 - v) ** 2, 3 * v ** 2 * (1 - v), v ** 3])
+    dB = np.array([-3 * (1 - v) ** 2, 3 * (1 - v) ** 2 - 6 * v * (1 - v), 6 * v * (1 - v) - 3 * v ** 2, 3 * v ** 2])
+    X, Z = B.T @ P[:, 0], B.T @ P[:, 1]
+    dX, dZ = dB.T @ P[:, 0], dB.T @ P[:, 1]
+    area = 0.5 * np.sum(0.5 * wts * (X * dZ - Z * dX))
+    exact = area * length
+assert abs(vol - exact) < 1e-9 * exact, (vol, exact)
+assert r["valid"], "every cell valid"
+print(kind, "fillet volume", vol, "exact", exact)
+PY
+}
+
+corner '"distance": [1, 0.5], "section": "flend", "dip": 0'
+"$trivox" build "$tmp/corner.json" -o "$tmp/chamfer.json" --json > "$tmp/build.out"
+check "$tmp/build.out" chamfer
+# Just under the chamfer plane (x - 2) / 1 + z / 0.5 = 1 at y = 2: in the fillet; just over: void.
+"$trivox" locate "$tmp/chamfer.json" --xyz 2.5,2,0.24 --json > "$tmp/in.out"
+"$trivox" locate "$tmp/chamfer.json" --xyz 2.5,2,0.26 --json > "$tmp/out.out"
+"$py" - "$tmp/in.out" "$tmp/out.out" <<'PY'
+import sys, json
+a, b = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert a["inside"] and a["cell"].startswith("fillet.1"), a
+assert not b["inside"], b
+# Sec. 7.1: the colour blends the floor's red and the wall's blue (the blend is convex).
+p = a["properties"]
+assert 0.0 <= p["r"] <= 1.0 and abs(p["r"] + p["b"] - 1) < 1e-9 and p["g"] == 0, a
+PY
+
+corner '"distance": [1, 0.5], "tau": 1.2'
+"$trivox" build "$tmp/corner.json" -o "$tmp/hermite.json" --json > "$tmp/build.out"
+check "$tmp/build.out" hermite
+"$trivox" build "$tmp/corner.json" -o "$tmp/hermite2.json" > "$tmp/human.out"
+grep -q "fillet.1 .*floor.w1/wall.u1 .*positive .*composed" "$tmp/human.out" || { cat "$tmp/human.out"; exit 1; }
+
+# The shipped models: exact composition for the Bezier spheres, fitted sub-regions on the
+# B-spline sphere and cone.
+for m in fillet_spheres:composed fillet_sphere_cone:fitted; do
+  "$trivox" build "models/${m%%:*}.json" -o "$tmp/m.json" --force --json > "$tmp/m.out"
+  "$py" - "$tmp/m.out" "${m##*:}" <<'PY'
+import sys, json
+r = json.load(open(sys.argv[1]))
+(f,) = r["fillets"]
+assert f["jacobian"] == "positive", f
+assert all(c == (sys.argv[2] == "composed") for c in f["composed"]), f["composed"]
+assert max(f["gap"]) < 1e-5 and max(f["g1_angle"]) < 1e-5, f
+assert r["valid"]
+PY
+done
+
+# Bad fillets: exit 2, the operation's place and what is wrong.
+corner '"distance": [2.5, 0.5]'
+expect_fail "corner.json: /operations/0: rails: the rail on face 1 at distance 2.5 leaves the face" \
+  "$trivox" build "$tmp/corner.json" -o "$tmp/x.json"
+corner '"distance": 1, "tau": 20'
+expect_fail "corner.json: /operations/0/tau: tau 20.0; expected a value in (0, 10]" "$trivox" build "$tmp/corner.json" -o "$tmp/x.json"
+corner '"distance": 1'
+sed -i 's/"min": \[1, -0.5, -0.5\], "max": \[2, 4.5, 3\]/"min": [1, -0.5, 1], "max": [2, 4.5, 3]/' "$tmp/corner.json"
+expect_fail "corner.json: /operations/0: fillet: the faces do not intersect" "$trivox" build "$tmp/corner.json" -o "$tmp/x.json"
+corner '"distance": 1'
+sed -i 's/\[{"cell": "floor", "face": "w1"}, {"cell": "wall", "face": "u1"}\]/["floor", "wall"]/' "$tmp/corner.json"
+expect_fail '/operations/0/between: "floor" and "wall" intersect on several pairs of faces (' \
+  "$trivox" build "$tmp/corner.json" -o "$tmp/x.json"
+[ ! -e "$tmp/x.json" ]
+echo "fillet: ok"
