@@ -165,13 +165,44 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
   geom::IntersectionOptions io;
   io.tolerance = tol;
   const std::vector<geom::IntersectionCurve> curves = geom::intersect_surfaces(s1, s2, io);
-  if (curves.empty()) throw Error("fillet: the faces do not intersect; expected faces that cross along a curve");
+  if (curves.empty()) {
+    // Tangent contact is no curve for the intersection either; tell it from no contact at all.
+    const geom::SurfaceDistance to2(s2);
+    geom::ClosestPoint best;
+    best.distance = std::numeric_limits<double>::infinity();
+    constexpr int n = 32;
+    std::vector<double> p(static_cast<std::size_t>(s1.dim()));
+    for (int a = 0; a <= n; ++a)
+      for (int b = 0; b <= n; ++b) {
+        const auto du = s1.domain(0), dv = s1.domain(1);
+        s1.eval({du[0] + (du[1] - du[0]) * a / n, dv[0] + (dv[1] - dv[0]) * b / n}, p.data());
+        const auto cp = to2.closest({p[0], p[1], p[2]});
+        if (cp.distance < best.distance) best = cp;
+      }
+    if (best.distance <= 1e3 * tol)
+      throw Error("fillet: the faces touch without crossing, near (" + num(best.point[0]) + ", " + num(best.point[1]) +
+                  ", " + num(best.point[2]) + "); expected faces that cross along a curve");
+    throw Error("fillet: the faces do not intersect (they come no closer than " + num(best.distance) +
+                "); expected faces that cross along a curve");
+  }
   std::vector<Fillet> out;
   for (const auto& curve : curves) {
     if (curve.points.size() < 2 || curve.xyz.size() == 0)
-      throw Error("fillet: the faces touch only at a point (" + num(curve.points[0].xyz[0]) + ", " +
+      throw Error("fillet: the faces touch at a point (" + num(curve.points[0].xyz[0]) + ", " +
                   num(curve.points[0].xyz[1]) + ", " + num(curve.points[0].xyz[2]) +
                   "); expected faces that cross along a curve");
+    // A contact that only just crosses (a tangent contact, or within the cells' own accuracy)
+    // is a point for the fillet: far smaller than the distances it is to be offset by.
+    std::array<double, 3> lo{}, hi{};
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (const auto& pt : curve.points)
+      for (std::size_t j = 0; j < 3; ++j) lo[j] = std::min(lo[j], pt.xyz[j]), hi[j] = std::max(hi[j], pt.xyz[j]);
+    const double extent = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    if (extent < 0.1 * std::min(o.distance[0], o.distance[1]))
+      throw Error("fillet: the faces touch at a point: their intersection near (" + num(lo[0]) + ", " + num(lo[1]) +
+                  ", " + num(lo[2]) + ") spans " + num(extent) + ", far less than the distance " +
+                  num(std::min(o.distance[0], o.distance[1])) + "; expected faces that cross along a curve");
     const auto start = std::chrono::steady_clock::now();
     RailOptions ro;
     ro.tolerance = tol;

@@ -6,7 +6,8 @@
 # control points) cuts from the corner, by Green's theorem in numpy; both meet the faces with no
 # gap, G1 below 1e-6 rad, det J > 0 inside, and carry each box's colour on its face. Points just
 # inside and outside the chamfer plane are in and out of the fillet. The shipped models build.
-# Bad fillets exit 2 naming the operation and what is wrong.
+# Bad fillets exit 2 naming the operation and what is wrong; a fillet whose det J changes sign
+# exits 1 and is not written.
 set -euo pipefail
 trivox=$1
 py=/usr/bin/python3
@@ -112,5 +113,24 @@ corner '"distance": 1'
 sed -i 's/\[{"cell": "floor", "face": "w1"}, {"cell": "wall", "face": "u1"}\]/["floor", "wall"]/' "$tmp/corner.json"
 expect_fail '/operations/0/between: "floor" and "wall" intersect on several pairs of faces (' \
   "$trivox" build "$tmp/corner.json" -o "$tmp/x.json"
+# A ball resting on a box touches it at one point: no curve to fillet along.
+cat > "$tmp/touch.json" <<'EOF'
+{ "trivox": 1, "units": "mm", "properties": ["r"],
+  "cells": [
+    {"name": "a", "primitive": {"type": "sphere", "center": [0, 0, 0], "radius": 5}, "field": {"constant": [1]}},
+    {"name": "b", "primitive": {"type": "box", "min": [5, -3, -3], "max": [8, 3, 3]}, "field": {"constant": [0]}}
+  ],
+  "operations": [{"op": "fillet", "between": [{"cell": "a.x1", "face": "w1"}, {"cell": "b", "face": "u0"}], "distance": 1}] }
+EOF
+expect_fail "touch.json: /operations/0: fillet: the faces touch at a point" "$trivox" build "$tmp/touch.json" -o "$tmp/x.json"
+[ ! -e "$tmp/x.json" ]
+# A tangent 6 times the width folds the Hermite section: reported (exit 1), not written.
+corner '"distance": [1, 0.5], "tau": 6'
+set +e
+"$trivox" build "$tmp/corner.json" -o "$tmp/x.json" > "$tmp/out" 2> "$tmp/err"
+rc=$?
+set -e
+[ $rc -eq 1 ] || { echo "expected exit 1, got $rc"; cat "$tmp/err"; exit 1; }
+grep -q '/operations/0: fillet 1 of "fillet": det J changes sign inside' "$tmp/err" || { cat "$tmp/err"; exit 1; }
 [ ! -e "$tmp/x.json" ]
 echo "fillet: ok"
