@@ -225,6 +225,8 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
     FilletQuality& q = f.quality;
     q.composed = {r1.composed, r2.composed};
     q.rail_error = {rp.rails[0].max_error, rp.rails[1].max_error};
+    q.face[0] = shape(s1);
+    q.face[1] = shape(s2);
     q.sub[0] = shape(sub1);
     q.sub[1] = shape(sub2);
     q.blend = shape(blend);

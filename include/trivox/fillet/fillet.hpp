@@ -50,7 +50,7 @@ struct FilletQuality {
   std::array<double, 2> property_jump{0.0, 0.0};  ///< max |g_fillet - g_i| on S^_i (0 without properties)
   std::array<bool, 2> composed{false, false}; ///< S^_i by exact composition (else fitted)
   std::array<double, 2> rail_error{0.0, 0.0}; ///< rails: largest deviation from the exact offset
-  SplineShape sub[2], blend, fillet;          ///< S^_1, S^_2, S_b, one half of T
+  SplineShape face[2], sub[2], blend, fillet; ///< S_1, S_2, S^_1, S^_2, S_b, one half of T
   double seconds = 0.0;                       ///< time to build this fillet
   /// "positive", "negative" (never after orientation) or "changes sign".
   std::string jacobian() const;
