@@ -280,6 +280,20 @@ TEST_CASE("kernel-based half Boolean sum trivariate (seed 004 Sec. 3.2, Lemma 2)
         for (int h = 0; h < 3; ++h) gap = std::max({gap, std::abs(p[h] - q[h]), std::abs(p2[h] - q2[h])});
       }
     CHECK(gap < 1e-12);
+    // KernelPoint::fitted is accepted no later than the centroid (here already at iteration 0,
+    // so the point stays the centroid), inside the kernel box, with the same boundaries.
+    o.kernel_point = construct::KernelPoint::fitted;
+    const auto f = construct::kernel_construct(KernelOp::half_boolean_sum, std::span<const Surface>(s), o);
+    REQUIRE(f.valid);
+    CHECK(f.iterations <= r.iterations);
+    REQUIRE(f.point.has_value());
+    CHECK((*f.point)[0] >= 0.0);
+    CHECK((*f.point)[0] <= 2.0);
+    CHECK((*f.point)[1] >= 0.0);
+    CHECK((*f.point)[1] <= 1.0);
+    CHECK((*f.point)[2] >= 0.0);
+    CHECK((*f.point)[2] <= 1.0);
+    CHECK(f.spline.eval({0.3, 0.7, 0.0})[0] == Approx(s[0].eval({0.3, 0.7})[0]).margin(1e-12));
   }
 }
 

@@ -11,20 +11,27 @@
 // a polyline of 40 points per curve cross), its regular construction is invalid
 // (geom::check_validity) and its boundary has a conservative kernel. Each kept
 // sample runs Alg. 1 with degree raising (up to degree 17; 40 for quadratic ruling) and with
-// refinement (up to 20 knots per span); success is Acceptance::nonnegative (det J >= 0, the
-// paper's criterion, Theorem 4). "1st" is success at iteration 0 (interior points moved to K,
-// nothing added), "accumulated" success within the maximum.
+// refinement (up to 20 knots per span); success is Acceptance::nonnegative (det J >= 0 with the
+// boundary's orientation, decided exactly from the Bezier coefficients of det J with
+// subdivision: the paper's criterion, Sec. 1 and Theorem 4). "1st" is success at iteration 0
+// (interior points moved, nothing added: Alg. 1's loop starts at i = 0 with S_0 itself),
+// "all" success within the maximum. Each dataset runs twice: with the interior points at the
+// kernel centroid (Alg. 1 line 9, "centroid") and with KernelPoint::fitted ("fitted": the
+// centroid first, then a point of a tighter conservative kernel where det J's coefficients
+// allow it; seed 004 Sec. 7).
 //
 // Deterministic: candidate i of a dataset draws from its own splitmix64 stream seeded by
 // (seed, dataset, i), candidates are screened in parallel but kept in index order, and each
 // kept sample's runs are independent, so the table does not depend on the thread count.
+// Screening tests the corners from the control polygons first (clamped curves) and prunes the
+// polyline's segment pairs by bounding boxes; the samples kept are the same as testing
+// everything on the curves.
 //
 // The paper does not say whether the inner control points are ordered along the curve: by
-// default they are drawn as they come (the literal reading); "sorted" as the fifth argument
-// orders them along the curve's direction (x for bottom and top, y for left and right).
+// default they are drawn as they come (the literal reading); `--inner sorted` orders them along
+// the curve's direction (x for bottom and top, y for left and right).
 //
-// Usage: trivox_bench_kernel_success [samples=1000] [threads=2] [seed=2023] [op|all]
-//                                    [unsorted|sorted] [cubic|quartic|quadratic|all]
+// Usage: trivox_bench_kernel_success --help
 #include <algorithm>
 #include <chrono>
 #include <cmath>
