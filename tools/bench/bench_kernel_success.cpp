@@ -48,6 +48,7 @@
 #include "trivox/error.hpp"
 #include "trivox/geom/kernel.hpp"
 #include "trivox/geom/validity.hpp"
+#include "trivox/spline/calculus.hpp"
 #include "trivox/spline/refine.hpp"
 
 using namespace trivox;
@@ -314,6 +315,87 @@ Candidate screen(KernelOp op, Kind kind, std::uint64_t seed, int dataset, std::u
   return c;
 }
 
+// ---------------------------------------------------------------------------------------------
+// --bounds: necessary conditions on the interior point. With every interior control point at K,
+// det J(K)(u,v) = A(u,v) + G(u,v) . K (terms with K twice are K x K = 0); requiring det J(K) >= 0
+// (with the boundary's orientation, the acceptance's tolerance) at samples (u,v) gives
+// half-planes in K. If they leave nothing of a region, no K in it can be accepted: an upper bound
+// on what any choice of a single point could give.
+
+spline::Surface with_interior(spline::Surface s, const V2& k) {
+  for (int r = 0; r < s.size(); ++r) {
+    const auto i = s.multi_index(r);
+    if (i[0] == 0 || i[1] == 0 || i[0] == s.count(0) - 1 || i[1] == s.count(1) - 1) continue;
+    s.point(r)[0] = k[0];
+    s.point(r)[1] = k[1];
+  }
+  return s;
+}
+
+std::vector<V2> clip_polygon(const std::vector<V2>& poly, double a, double b, double c) {
+  std::vector<V2> out;
+  const std::size_t n = poly.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const V2 &p = poly[i], &q = poly[(i + 1) % n];
+    const double dp = a * p[0] + b * p[1] + c, dq = a * q[0] + b * q[1] + c;
+    if (dp >= 0) out.push_back(p);
+    if ((dp > 0 && dq < 0) || (dp < 0 && dq > 0)) {
+      const double t = dp / (dp - dq);
+      out.push_back({p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])});
+    }
+  }
+  return out;
+}
+
+/// Whether some K in the convex polygon `region` meets det J(K) >= -1e-9 max|det J| at every
+/// point of a 101 x 101 parameter grid (false proves that no K in it is accepted).
+bool some_point_possible(const spline::Surface& s, int orientation, std::vector<V2> region) {
+  const spline::Surface d0 = spline::jacobian_determinant(with_interior(s, {0, 0}));
+  const spline::Surface dx = spline::jacobian_determinant(with_interior(s, {1, 0}));
+  const spline::Surface dy = spline::jacobian_determinant(with_interior(s, {0, 1}));
+  const int n = 100;
+  std::vector<std::array<double, 3>> h;
+  double scale = 0.0;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const std::array<double, 2> uv{s.domain(0)[0] + (s.domain(0)[1] - s.domain(0)[0]) * i / n,
+                                     s.domain(1)[0] + (s.domain(1)[1] - s.domain(1)[0]) * j / n};
+      const double a = d0.eval(uv)[0];
+      h.push_back({orientation * (dx.eval(uv)[0] - a), orientation * (dy.eval(uv)[0] - a), orientation * a});
+      scale = std::max(scale, std::abs(a));
+    }
+  const double tau = 1e-9 * scale;
+  for (const auto& c : h) {
+    const double len = std::hypot(c[0], c[1]);
+    if (len <= 1e-14 * scale) {
+      if (c[2] < -tau) return false;
+      continue;
+    }
+    region = clip_polygon(region, c[0] / len, c[1] / len, (c[2] + tau) / len);
+    if (region.size() < 3) return false;
+  }
+  return true;
+}
+
+struct Possible {
+  bool plane = false, kernel = false;
+};
+
+/// Some point in [-3, 3]^2, some in the conservative kernel with 8 refinements (inside the true
+/// kernel), possible for s (S_0 with freedom added).
+Possible possible(const spline::Surface& s0, const spline::Surface& s) {
+  Possible p;
+  const auto k = geom::planar_kernel(s0);
+  p.plane = some_point_possible(s, k.orientation, {{-3, -3}, {3, -3}, {3, 3}, {-3, 3}});
+  if (p.plane) {
+    geom::KernelOptions o;
+    o.refinements = 8;
+    const auto tight = geom::planar_kernel(s0, o);
+    p.kernel = !tight.empty() && some_point_possible(s, k.orientation, {tight.vertices.begin(), tight.vertices.end()});
+  }
+  return p;
+}
+
 /// Iteration of first success (-1: none) of Alg. 1 with the given way of adding freedom.
 int run(const spline::Surface& s0, AddDof how, int max_dof, construct::KernelPoint point) {
   construct::KernelConstructOptions o;
@@ -332,12 +414,13 @@ struct Args {
   std::string curves = "all";
   bool sorted = false;
   std::string point = "both";
+  bool bounds = false;
 };
 
 const char* usage =
     "usage: trivox_bench_kernel_success [--samples N=1000] [--threads N=2] [--seed N=2023]\n"
     "         [--op boolean_sum|half_boolean_sum|ruled|all] [--curves cubic|quartic|quadratic|all]\n"
-    "         [--inner unsorted|sorted] [--point centroid|fitted|both]\n"
+    "         [--inner unsorted|sorted] [--point centroid|fitted|both] [--bounds]\n"
     "Success rates of the kernel-based constructors on the random datasets of seed 004 Sec. 5.1.\n"
     "  --samples   samples kept per dataset (regular construction invalid, boundary with a kernel)\n"
     "  --threads   TBB threads (the table does not depend on it)\n"
@@ -345,6 +428,9 @@ const char* usage =
     "  --inner     inner control points as drawn (the paper's text) or sorted along the curve\n"
     "  --point     interior control points at the kernel centroid (Alg. 1), at the fitted point\n"
     "              when the centroid fails (construct::KernelPoint::fitted, seed 004 Sec. 7), or both\n"
+    "  --bounds    also upper bounds for any single interior point (necessary conditions on a\n"
+    "              101 x 101 grid): at iteration 0, and with degree raising for the samples that\n"
+    "              the last --point fails (slow for high degrees)\n"
     "The old positional form [samples] [threads] [seed] [op] [unsorted|sorted] [curves] is accepted.\n";
 
 bool parse(int argc, char** argv, Args& a) {
@@ -352,6 +438,10 @@ bool parse(int argc, char** argv, Args& a) {
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
     if (k == "--help" || k == "-h") return std::fputs(usage, stdout), std::exit(0), true;
+    if (k == "--bounds") {
+      a.bounds = true;
+      continue;
+    }
     if (k.rfind("--", 0) == 0) {
       if (i + 1 >= argc) return false;
       const std::string v = argv[++i];
@@ -473,6 +563,30 @@ int main(int argc, char** argv) {
         std::printf("    raising, successes per iteration:%s\n", histogram(elev, max_degree - degree).c_str());
         std::printf("    refining, successes per iteration:%s\n", histogram(refi, 20).c_str());
         std::fflush(stdout);
+        if (args.bounds && point == points.back()) {
+          // Iteration 0 for every sample; raising at every degree for the samples that failed.
+          std::vector<Possible> first(static_cast<std::size_t>(n)), raised(static_cast<std::size_t>(n));
+          tbb::parallel_for(0, n, [&](int j) {
+            const auto i = static_cast<std::size_t>(j);
+            first[i] = possible(kept[i].s0, kept[i].s0);
+            if (elev[i] >= 0) return raised[i] = {true, true}, void();
+            for (int r = 0; r <= max_degree - degree && !raised[i].kernel; ++r) {
+              const spline::Surface s = r == 0 ? kept[i].s0 : spline::elevate(spline::elevate(kept[i].s0, 0, r), 1, r);
+              const Possible p = r == 0 ? first[i] : possible(kept[i].s0, s);
+              raised[i].plane = raised[i].plane || p.plane;
+              raised[i].kernel = raised[i].kernel || p.kernel;
+            }
+          });
+          auto share = [&](const std::vector<Possible>& v, bool Possible::*m) {
+            return 100.0 * static_cast<double>(std::count_if(v.begin(), v.end(), [&](const Possible& p) { return p.*m; })) /
+                   std::max(1, n);
+          };
+          std::printf("    bounds (any single point; necessary conditions): iteration 0 <= %.1f%% in [-3,3]^2, <= %.1f%% in "
+                      "the kernel; raising, all <= %.1f%% / %.1f%%\n",
+                      share(first, &Possible::plane), share(first, &Possible::kernel), share(raised, &Possible::plane),
+                      share(raised, &Possible::kernel));
+          std::fflush(stdout);
+        }
       }
     }
   std::printf("\ntotal %.1f s\n", std::chrono::duration<double>(Clock::now() - t_all).count());
