@@ -61,76 +61,112 @@ ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p) const {
       best[k] = i;
     }
   }
-  const auto du = surface_.domain(0), dv = surface_.domain(1);
-  const double lo[2] = {du[0], dv[0]}, hi[2] = {du[1], dv[1]};
   const int dim = surface_.dim();
   std::vector<double> buf(static_cast<std::size_t>(6 * dim)), val(static_cast<std::size_t>(dim));
-  const auto f_at = [&](const std::array<double, 2>& t) {
-    surface_.eval(t, val.data());
-    const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
-    return dot3(r, r);
-  };
   ClosestPoint out;
   out.distance = std::numeric_limits<double>::infinity();
   const std::size_t starts = std::min<std::size_t>(3, xyz_.size());
   for (std::size_t s = 0; s < starts; ++s) {
     std::array<double, 2> t = uv_[best[s]];
     double f = best_d[s];
-    for (int it = 0; it < 40; ++it) {
-      surface_.eval_derivatives(t, 2, buf.data());
-      const double* S = buf.data();
-      const double* Su = S + dim;
-      const double* Sv = S + 2 * dim;
-      const double* Suu = S + 3 * dim;
-      const double* Suv = S + 4 * dim;
-      const double* Svv = S + 5 * dim;
-      const double r[3] = {S[0] - p[0], S[1] - p[1], S[2] - p[2]};
-      const double g[2] = {dot3(r, Su), dot3(r, Sv)};
-      double H[2][2] = {{dot3(Su, Su) + dot3(r, Suu), dot3(Su, Sv) + dot3(r, Suv)},
-                        {0.0, dot3(Sv, Sv) + dot3(r, Svv)}};
-      H[1][0] = H[0][1];
-      if (!(H[0][0] > 0 && H[0][0] * H[1][1] - H[0][1] * H[0][1] > 0)) {  // Gauss-Newton away from convexity
-        H[0][0] = dot3(Su, Su);
-        H[1][1] = dot3(Sv, Sv);
-        H[0][1] = H[1][0] = dot3(Su, Sv);
-      }
-      // Coordinates at a bound whose descent direction leaves the domain are frozen.
-      bool frozen[2] = {false, false};
-      for (int d = 0; d < 2; ++d)
-        frozen[d] = (t[static_cast<std::size_t>(d)] <= lo[d] && g[d] > 0) || (t[static_cast<std::size_t>(d)] >= hi[d] && g[d] < 0);
-      double step[2] = {0.0, 0.0};
-      if (!frozen[0] && !frozen[1]) {
-        const double det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
-        if (std::abs(det) > 0) {
-          step[0] = -(H[1][1] * g[0] - H[0][1] * g[1]) / det;
-          step[1] = -(H[0][0] * g[1] - H[1][0] * g[0]) / det;
-        }
-      } else {
-        for (int d = 0; d < 2; ++d)
-          if (!frozen[d] && H[d][d] > 0) step[d] = -g[d] / H[d][d];
-      }
-      double lambda = 1.0;
-      std::array<double, 2> next{};
-      double fn = f;
-      for (int h = 0; h < 30; ++h, lambda *= 0.5) {
-        for (std::size_t d = 0; d < 2; ++d) next[d] = std::clamp(t[d] + lambda * step[d], lo[d], hi[d]);
-        fn = f_at(next);
-        if (fn <= f) break;
-      }
-      const double moved = std::abs(next[0] - t[0]) / (hi[0] - lo[0]) + std::abs(next[1] - t[1]) / (hi[1] - lo[1]);
-      if (!(fn <= f)) break;  // no descent: t is stationary to working precision
-      t = next;
-      f = fn;
-      if (moved < 1e-15) break;
-    }
+    const bool conv = descend(p, t, f, buf.data(), val.data());
     if (std::sqrt(f) < out.distance) {
       surface_.eval(t, val.data());
       out.uv = t;
       out.point = {val[0], val[1], val[2]};
       out.distance = std::sqrt(f);
+      out.converged = conv;
     }
   }
   return out;
+}
+
+ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p, const std::array<double, 2>& start,
+                                      double* values) const {
+  const int dim = surface_.dim();
+  // Stack buffers for the common case (up to 16 coordinates), no allocation per query.
+  double sbuf[6 * 16], sval[16];
+  std::vector<double> hbuf, hval;
+  double* buf = sbuf;
+  double* val = sval;
+  if (dim > 16) {
+    hbuf.resize(static_cast<std::size_t>(6 * dim));
+    hval.resize(static_cast<std::size_t>(dim));
+    buf = hbuf.data();
+    val = hval.data();
+  }
+  const auto du = surface_.domain(0), dv = surface_.domain(1);
+  std::array<double, 2> t{std::clamp(start[0], du[0], du[1]), std::clamp(start[1], dv[0], dv[1])};
+  surface_.eval(t, val);
+  const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
+  double f = dot3(r, r);
+  ClosestPoint out;
+  out.converged = descend(p, t, f, buf, val);
+  surface_.eval(t, val);
+  out.uv = t;
+  out.point = {val[0], val[1], val[2]};
+  out.distance = std::sqrt(f);
+  if (values) std::copy(val, val + dim, values);
+  return out;
+}
+
+bool SurfaceDistance::descend(const std::array<double, 3>& p, std::array<double, 2>& t, double& f, double* buf,
+                              double* val) const {
+  const auto du = surface_.domain(0), dv = surface_.domain(1);
+  const double lo[2] = {du[0], dv[0]}, hi[2] = {du[1], dv[1]};
+  const int dim = surface_.dim();
+  const auto f_at = [&](const std::array<double, 2>& x) {
+    surface_.eval(x, val);
+    const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
+    return dot3(r, r);
+  };
+  for (int it = 0; it < 40; ++it) {
+    surface_.eval_derivatives(t, 2, buf);
+    const double* S = buf;
+    const double* Su = S + dim;
+    const double* Sv = S + 2 * dim;
+    const double* Suu = S + 3 * dim;
+    const double* Suv = S + 4 * dim;
+    const double* Svv = S + 5 * dim;
+    const double r[3] = {S[0] - p[0], S[1] - p[1], S[2] - p[2]};
+    const double g[2] = {dot3(r, Su), dot3(r, Sv)};
+    double H[2][2] = {{dot3(Su, Su) + dot3(r, Suu), dot3(Su, Sv) + dot3(r, Suv)}, {0.0, dot3(Sv, Sv) + dot3(r, Svv)}};
+    H[1][0] = H[0][1];
+    if (!(H[0][0] > 0 && H[0][0] * H[1][1] - H[0][1] * H[0][1] > 0)) {  // Gauss-Newton away from convexity
+      H[0][0] = dot3(Su, Su);
+      H[1][1] = dot3(Sv, Sv);
+      H[0][1] = H[1][0] = dot3(Su, Sv);
+    }
+    // Coordinates at a bound whose descent direction leaves the domain are frozen.
+    bool frozen[2] = {false, false};
+    for (int d = 0; d < 2; ++d)
+      frozen[d] = (t[static_cast<std::size_t>(d)] <= lo[d] && g[d] > 0) || (t[static_cast<std::size_t>(d)] >= hi[d] && g[d] < 0);
+    double step[2] = {0.0, 0.0};
+    if (!frozen[0] && !frozen[1]) {
+      const double det = H[0][0] * H[1][1] - H[0][1] * H[1][0];
+      if (std::abs(det) > 0) {
+        step[0] = -(H[1][1] * g[0] - H[0][1] * g[1]) / det;
+        step[1] = -(H[0][0] * g[1] - H[1][0] * g[0]) / det;
+      }
+    } else {
+      for (int d = 0; d < 2; ++d)
+        if (!frozen[d] && H[d][d] > 0) step[d] = -g[d] / H[d][d];
+    }
+    double lambda = 1.0;
+    std::array<double, 2> next{};
+    double fn = f;
+    for (int h = 0; h < 30; ++h, lambda *= 0.5) {
+      for (std::size_t d = 0; d < 2; ++d) next[d] = std::clamp(t[d] + lambda * step[d], lo[d], hi[d]);
+      fn = f_at(next);
+      if (fn <= f) break;
+    }
+    const double moved = std::abs(next[0] - t[0]) / (hi[0] - lo[0]) + std::abs(next[1] - t[1]) / (hi[1] - lo[1]);
+    if (!(fn <= f)) return true;  // no descent: t is stationary to working precision
+    t = next;
+    f = fn;
+    if (moved < 1e-15) return true;
+  }
+  return false;
 }
 
 double distance(const std::vector<SurfaceDistance>& surfaces, const std::array<double, 3>& p) {

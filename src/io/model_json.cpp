@@ -116,6 +116,25 @@ void read_trims(const Source& src, const json& item, const std::string& ip, cons
   }
 }
 
+/// A Shepard fillet cell's "shepard": {"power": q, "surfaces": [S^_1, S^_2]} (vmodel::ShepardData;
+/// written by fillets built with "blend": "shepard"), surfaces in R^(3+m) like the cells.
+void read_shepard(const Source& src, const json& item, const std::string& ip, const PointShape& shape,
+                  vmodel::VCell& cell) {
+  const json* j = find(item, "shepard");
+  if (j == nullptr) return;
+  const std::string sp = child(ip, "shepard");
+  const std::string what = "{\"power\": q, \"surfaces\": [S1, S2]}";
+  const json& o = expect_object(src, *j, sp, "a Shepard blend " + what);
+  vmodel::ShepardData d;
+  d.power = read_int(src, require(src, o, sp, "power", what), child(sp, "power"), 1, 16, "a power q, an integer in 1..16");
+  const std::string lp = child(sp, "surfaces");
+  const json& list = require(src, o, sp, "surfaces", what);
+  if (!list.is_array() || list.size() != 2)
+    src.fail(lp, describe(list) + "; expected an array of two surfaces {\"orders\", \"knots\", \"points\"} (S^_1, S^_2)");
+  for (std::size_t i = 0; i < 2; ++i) d.sources[i] = read_spline<2>(src, list[i], child(lp, i), shape);
+  cell.shepard = std::move(d);
+}
+
 vmodel::VCell read_cell(const Source& src, const json& item_in, const std::string& ip, const PointShape& shape,
                         NameTable& names, int depth) {
   const std::string what = "{\"name\", \"trivariate\"}";
@@ -124,6 +143,7 @@ vmodel::VCell read_cell(const Source& src, const json& item_in, const std::strin
   vmodel::VCell cell(std::move(name),
                      read_spline<3>(src, require(src, item, ip, "trivariate", what), child(ip, "trivariate"), shape));
   read_trims(src, item, ip, shape, cell, depth);
+  read_shepard(src, item, ip, shape, cell);
   return cell;
 }
 
@@ -204,6 +224,21 @@ void check_trims(const vmodel::VCell& c, const PointShape& shape) {
       for (double v : f.points())
         if (!std::isfinite(v)) throw Error(cannot_write + quote(c.name) + " has a non-finite boundary; expected finite numbers");
     }
+  if (c.shepard) {
+    if (c.shepard->power < 1 || c.shepard->power > 16)
+      throw Error(cannot_write + quote(c.name) + " has Shepard power " + std::to_string(c.shepard->power) +
+                  "; expected an integer in 1..16");
+    for (const auto& f : c.shepard->sources) {
+      if (f.dim() != shape.dim)
+        throw Error(cannot_write + quote(c.name) + " has a Shepard surface with " + plural(f.dim(), "coordinate") +
+                    "; expected " + shape.text);
+      for (double v : f.points())
+        if (!std::isfinite(v)) throw Error(cannot_write + quote(c.name) + " has a non-finite Shepard surface; expected finite numbers");
+      for (double w : f.weights())
+        if (!(w > 0) || !std::isfinite(w))
+          throw Error(cannot_write + quote(c.name) + " has a Shepard surface weight " + format_double(w) + "; expected positive finite weights");
+    }
+  }
   NameTable within;
   for (const auto& w : c.within) {
     check_item(w.name, w.volume, shape, within);
@@ -269,6 +304,11 @@ void write_cell(std::string& out, const vmodel::VCell& c, const std::string& ind
   if (!c.boundaries.empty()) {
     out += ",\n" + in1 + "\"boundaries\": ";
     write_list(out, c.boundaries, [&](const std::vector<spline::Surface>& list) { write_list(out, list, spline); });
+  }
+  if (c.shepard) {
+    out += ",\n" + in1 + "\"shepard\": {\"power\": " + std::to_string(c.shepard->power) + ", \"surfaces\": ";
+    write_list(out, c.shepard->sources, spline);
+    out += "}";
   }
   out += "\n" + indent + "}";
 }

@@ -6,6 +6,7 @@
 #include "json_io.hpp"
 
 #include "trivox/error.hpp"
+#include "trivox/fillet/shepard.hpp"
 #include "trivox/geom/surface_intersection.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/io/model_file.hpp"
@@ -205,7 +206,7 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
 void read_fillet(const Source& src, const json& item, const std::string& ip, SceneOperation& o) {
   const std::string what =
       "a fillet {\"op\": \"fillet\", \"between\": [A, B], \"distance\", \"tau\", \"section\", \"dip\", "
-      "\"method\", \"blend\", \"flip\", \"name\"}";
+      "\"method\", \"blend\", \"power\", \"flip\", \"name\"}";
   const std::string bp = child(ip, "between");
   const json& between = require(src, item, ip, "between", what);
   const std::string bwhat = "two cells: names or {\"cell\": NAME, \"face\": \"u0\"..\"w1\"}";
@@ -262,11 +263,14 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
       src.fail(child(ip, "method"), "unknown method " + quote(m) + "; expected \"auto\", \"compose\" or \"fit\"");
   }
   if (const json* t = find(item, "blend")) {
-    const std::string b = read_string(src, *t, child(ip, "blend"), "\"parametric\"");
-    if (b == "shepard")
-      src.fail(child(ip, "blend"), "\"shepard\" is not supported yet (Euclidean-distance blends are later work); "
-                                   "expected \"parametric\"");
-    if (b != "parametric") src.fail(child(ip, "blend"), "unknown blend " + quote(b) + "; expected \"parametric\"");
+    const std::string b = read_string(src, *t, child(ip, "blend"), "\"parametric\" or \"shepard\"");
+    if (b != "parametric" && b != "shepard")
+      src.fail(child(ip, "blend"), "unknown blend " + quote(b) + "; expected \"parametric\" or \"shepard\"");
+    o.shepard = b == "shepard";
+  }
+  if (const json* t = find(item, "power")) {  // Shepard's q (fillet/shepard.hpp)
+    o.shepard_power = read_int(src, *t, child(ip, "power"), 1, 16, "a power q, an integer in 1..16");
+    if (!o.shepard) src.fail(child(ip, "power"), "a power without \"blend\": \"shepard\"; expected it only with the Shepard blend");
   }
   if (const json* t = find(item, "flip")) {
     const std::string fp = child(ip, "flip");
@@ -419,8 +423,23 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
     const std::string base = op.name + "." + std::to_string(k + 1);
     rep.cell_names.push_back({base + "a", base + "b"});
     rep.quality.push_back(q);
-    cells.emplace_back(base + "a", fillets[k].halves[0]);
-    cells.emplace_back(base + "b", fillets[k].halves[1]);
+    if (!op.shepard) {
+      cells.emplace_back(base + "a", fillets[k].halves[0]);
+      cells.emplace_back(base + "b", fillets[k].halves[1]);
+      continue;
+    }
+    // Seed 000 Sec. 7.2: both halves carry f, encoded, and S^_1, S^_2 (their faces w = 0) for
+    // the exact per-voxel value.
+    vmodel::ShepardData sd;
+    sd.power = op.shepard_power;
+    for (std::size_t h = 0; h < 2; ++h) sd.sources[h] = spline::boundary_face(fillets[k].halves[h], spline::Face::w0);
+    const fillet::ShepardField field(sd);
+    for (std::size_t h = 0; h < 2; ++h) {
+      auto enc = fillet::encode_shepard(fillets[k].halves[h], field, {.power = op.shepard_power});
+      rep.shepard.push_back({enc.max_error, enc.rms_error, enc.check_error, enc.samples, enc.seconds});
+      cells.emplace_back(base + (h == 0 ? "a" : "b"), std::move(enc.half));
+      cells.back().shepard = sd;
+    }
   }
   out.fillets.push_back(std::move(rep));
   return cells;

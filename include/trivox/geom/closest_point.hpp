@@ -12,8 +12,17 @@
 /// basin unlikely for the smooth, gently curved faces of cells, not impossible for a surface
 /// that folds back within one grid spacing.
 ///
+/// Warm starts (closest(p, start)): Newton from a given (u,v), typically the answer at a nearby
+/// point, skipping the sample pass. It converges to the local minimum whose basin holds the start:
+/// the same point as the cold query (to rounding) when both starts lie in the global minimum's
+/// basin, which holds for points moving little against the surface's curvature radius; it is not
+/// certified. Callers that need start-independent bytes keep the chain of warm starts
+/// deterministic (fillet/shepard.hpp: per sampler block, cold at every row start) and check the
+/// answer against the 1-Lipschitz bound of the distance (WarmCheck).
+///
 /// Cost: building: samples_per_span^2 * spans evaluations; a query: one pass over the samples
-/// (3 flops each) and a few evaluations with second partials.
+/// (3 flops each) and a few evaluations with second partials; a warm query: the evaluations only
+/// (two or three Newton steps for a start one voxel away).
 #pragma once
 #include <array>
 #include <vector>
@@ -26,6 +35,9 @@ struct ClosestPoint {
   std::array<double, 2> uv{};      ///< parameters of the closest point
   std::array<double, 3> point{};   ///< S(uv), xyz
   double distance = 0.0;           ///< |S(uv) - P|
+  /// Newton ended at a stationary point (step below 1e-15 of the domain, or no descent left);
+  /// false when it ran out of iterations.
+  bool converged = true;
 };
 
 /// A surface prepared for closest-point queries (xyz: coordinates 0..2).
@@ -38,9 +50,19 @@ public:
   /// The closest point to p. Thread-safe.
   ClosestPoint closest(const std::array<double, 3>& p) const;
 
+  /// The local minimum of |S - p| reached by damped, projected Newton from `start` (clamped to
+  /// the domain) alone: no sample pass (see the file comment on warm starts). Thread-safe.
+  /// @param values  when not null: the surface's dim() coordinates at the answer (xyz and any
+  ///                properties it carries), from the evaluation that gives `point`
+  ClosestPoint closest(const std::array<double, 3>& p, const std::array<double, 2>& start,
+                       double* values = nullptr) const;
+
   const spline::Surface& surface() const noexcept { return surface_; }
 
 private:
+  /// Newton from t (with |S(t) - p|^2 = f) to a stationary point; returns converged.
+  bool descend(const std::array<double, 3>& p, std::array<double, 2>& t, double& f, double* buf, double* val) const;
+
   spline::Surface surface_;
   std::vector<std::array<double, 2>> uv_;   ///< sample parameters
   std::vector<std::array<double, 3>> xyz_;  ///< sample points

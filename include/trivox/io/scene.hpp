@@ -18,7 +18,8 @@
 /// earlier results; the operation consumes a and b and puts its result, untrimmed
 /// (slice::untrim), where a was. Fillets (fillet/fillet.hpp: seed 000 Alg. 2 with Sec. 7.1):
 /// {"op": "fillet", "between": [A, B], "distance": d | [d1, d2], "tau", "section": "hermite" |
-/// "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric", "flip": bool |
+/// "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric" | "shepard",
+/// "power": q (Shepard only, 1..16, default 2; fillet/shepard.hpp, seed 000 Sec. 7.2), "flip": bool |
 /// [bool, bool], "name"}, A and B cell names or {"cell": NAME, "face": "u0".."w1"}; without
 /// faces, the one pair of faces that intersects is used. The fillet's cells, two per
 /// intersection component (`<name>.<k>a`, `<name>.<k>b`), are appended to the model; the
@@ -29,6 +30,7 @@
 /// Cost: linear in the file size to read; building is the primitives' cost (milliseconds each)
 /// plus any field refinement.
 #pragma once
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -73,6 +75,8 @@ struct SceneOperation {
   std::array<std::string, 2> between;
   std::array<std::optional<spline::Face>, 2> faces;
   fillet::FilletOptions fillet;
+  bool shepard = false;     ///< "blend": "shepard" (seed 000 Sec. 7.2), else parametric (Sec. 7.1)
+  int shepard_power = 2;    ///< "power": Shepard's q, 1..16
 };
 
 struct Scene {
@@ -113,6 +117,13 @@ struct FilletBuild {
   std::array<spline::Face, 2> faces{};
   std::vector<std::array<std::string, 2>> cell_names;  ///< per component: its two cells in the model
   std::vector<fillet::FilletQuality> quality;          ///< per component
+  /// "blend": "shepard": the encoding's fit of f per cell (two per component, a then b).
+  struct ShepardFit {
+    double max_error = 0.0, rms_error = 0.0, check_error = 0.0;
+    std::int64_t samples = 0;
+    double seconds = 0.0;
+  };
+  std::vector<ShepardFit> shepard;
 };
 
 struct SceneBuild {

@@ -5,6 +5,7 @@
 /// This is the data every module passes around. Topology (V-surfaces, half-V-surfaces,
 /// V-curves, V-points), trimming and Booleans build on it.
 #pragma once
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -46,6 +47,21 @@ struct FaceTrim {
   bool operator==(const FaceTrim&) const = default;
 };
 
+/// The data of a fillet cell whose properties are the Euclidean-distance (Shepard) blend of
+/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 7.2, after Biswas et al. 2004: at a point p,
+/// f(p) = alpha_1 g_1(pi_1(p)) + alpha_2 g_2(pi_2(p)), alpha_i = d_i^-q / (d_1^-q + d_2^-q), d_i
+/// the distance from p to the fillet's sub-region S^_i, pi_i(p) its closest point there and g_i
+/// the properties S^_i carries. The cell's own property control points hold the least-squares
+/// encoding of f (fillet/shepard.hpp); this lets the slicer evaluate f exactly per voxel
+/// (`trivox slice --blend shepard`).
+struct ShepardData {
+  /// S^_1, S^_2 in R^(3+m): xyz then the m properties g_i, as the model's cells.
+  std::array<spline::Surface, 2> sources;
+  int power = 2;  ///< q, a positive integer (1..16)
+
+  bool operator==(const ShepardData&) const = default;
+};
+
 /// One volumetric cell: a trivariate in R^(3+m), coordinates 0..2 xyz and 3.. the properties.
 ///
 /// A plain cell is the image of its trivariate. A cell made by a Boolean operation (seed 003
@@ -72,6 +88,8 @@ struct VCell {
   std::vector<std::vector<spline::Surface>> boundaries;
   /// Booleans: where the other input's faces cut this cell's faces (per face, in order).
   std::vector<FaceTrim> trim_curves;
+  /// Fillets built with the Shepard blend: the data for the exact per-voxel value.
+  std::optional<ShepardData> shepard;
 
   /// No trimming: the cell is its trivariate's image.
   bool plain() const noexcept { return within.empty() && without.empty(); }

@@ -1,0 +1,331 @@
+#include "trivox/fillet/shepard.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "trivox/error.hpp"
+#include "trivox/geom/quadrature.hpp"
+#include "trivox/spline/refine.hpp"
+
+namespace trivox::fillet {
+
+std::array<double, 2> shepard_weights(double d1, double d2, int q) noexcept {
+  if (!(d1 > 0) && !(d2 > 0)) return {0.5, 0.5};  // on C: both distances vanish
+  // alpha_near = 1 / (1 + (d_near / d_far)^q): d^-q never formed, so no overflow on S^_i.
+  const bool first = d1 <= d2;
+  const double r = first ? d1 / d2 : d2 / d1;
+  double t = 1.0;
+  for (int k = 0; k < q; ++k) t *= r;
+  const double near = 1.0 / (1.0 + t);
+  return first ? std::array<double, 2>{near, 1.0 - near} : std::array<double, 2>{1.0 - near, near};
+}
+
+namespace {
+
+const spline::Surface& checked_source(const std::array<spline::Surface, 2>& s, std::size_t i, int power) {
+  if (s[0].dim() != s[1].dim())
+    throw Error("Shepard blend: S^_1 has " + std::to_string(s[0].dim()) + " coordinates and S^_2 " +
+                std::to_string(s[1].dim()) + "; expected the same (xyz and the same properties)");
+  if (s[i].dim() < 3)
+    throw Error("Shepard blend: S^_" + std::to_string(i + 1) + " has " + std::to_string(s[i].dim()) +
+                " coordinates; expected at least 3 (xyz)");
+  if (power < 1 || power > 16)
+    throw Error("Shepard blend: power " + std::to_string(power) + "; expected an integer q in 1..16");
+  return s[i];
+}
+
+double box_diagonal(const spline::Surface& s) {
+  const auto b = s.control_box();
+  double d = 0.0;
+  for (std::size_t k = 0; k < 3; ++k) d += (b[1][k] - b[0][k]) * (b[1][k] - b[0][k]);
+  return std::sqrt(d);
+}
+
+}  // namespace
+
+ShepardField::ShepardField(const std::array<spline::Surface, 2>& sources, int power)
+    : dist_{geom::SurfaceDistance(checked_source(sources, 0, power)), geom::SurfaceDistance(checked_source(sources, 1, power))},
+      m_(sources[0].dim() - 3),
+      q_(power) {
+  slack_ = 1e-9 * std::max(box_diagonal(sources[0]), box_diagonal(sources[1]));
+}
+
+ShepardValue ShepardField::eval(const std::array<double, 3>& p, double* props, ShepardWalk* walk) const {
+  const int dim = 3 + m_;
+  constexpr int stack_dim = 32;
+  double sval[2][stack_dim];
+  std::vector<double> hval;
+  double* val[2] = {sval[0], sval[1]};
+  if (dim > stack_dim) {
+    hval.resize(2 * static_cast<std::size_t>(dim));
+    val[0] = hval.data();
+    val[1] = hval.data() + dim;
+  }
+  ShepardValue out;
+  const double step = walk && walk->valid ? std::hypot(p[0] - walk->p[0], p[1] - walk->p[1], p[2] - walk->p[2]) : 0.0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    geom::ClosestPoint c;
+    bool done = false;
+    if (walk && walk->valid) {
+      c = dist_[i].closest(p, walk->uv[i], val[i]);
+      // The distance is 1-Lipschitz: a warm answer farther than the previous distance plus the
+      // step is certainly not the global minimum.
+      done = c.converged && c.distance <= walk->d[i] + step + slack_;
+      if (done) ++walk->warm;
+    }
+    if (!done) {
+      c = dist_[i].closest(p);
+      dist_[i].surface().eval(c.uv, val[i]);
+      if (walk) ++walk->cold;
+    }
+    out.distance[i] = c.distance;
+    out.uv[i] = c.uv;
+  }
+  out.alpha = shepard_weights(out.distance[0], out.distance[1], q_);
+  for (int h = 0; h < m_; ++h) props[h] = out.alpha[0] * val[0][3 + h] + out.alpha[1] * val[1][3 + h];
+  if (walk) {
+    walk->valid = true;
+    walk->p = p;
+    walk->uv = out.uv;
+    walk->d = out.distance;
+  }
+  return out;
+}
+
+// ---- encoding ----
+
+namespace {
+
+/// A dense row-major matrix.
+struct Matrix {
+  int rows = 0, cols = 0;
+  std::vector<double> a;
+  Matrix(int r, int c) : rows(r), cols(c), a(static_cast<std::size_t>(r) * static_cast<std::size_t>(c), 0.0) {}
+  double& operator()(int i, int j) { return a[static_cast<std::size_t>(i) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(j)]; }
+  double operator()(int i, int j) const { return a[static_cast<std::size_t>(i) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(j)]; }
+};
+
+/// The fit space along u or v: the half's own for few control points, else order <= 4 on at
+/// most max_spans of its breakpoints, multiplicities lowered with the order so that the space
+/// elevated to the half's order lies in the half's (where the half is smooth enough to allow it).
+spline::KnotVector fit_space(const spline::KnotVector& kv, const ShepardOptions& opt) {
+  if (kv.size() <= opt.max_direct) return kv;
+  const int o = kv.order(), oc = std::min(4, o);
+  const auto br = kv.breakpoints();
+  const int spans = static_cast<int>(br.size()) - 1;
+  const int stride = (spans + opt.max_spans - 1) / opt.max_spans;
+  std::vector<spline::Breakpoint> keep{br.front()};
+  for (int s = stride; s < spans; s += stride) {
+    const int mult = std::clamp(br[static_cast<std::size_t>(s)].multiplicity - (o - oc), 1, oc - 1);
+    keep.push_back({br[static_cast<std::size_t>(s)].value, mult});
+  }
+  keep.push_back(br.back());
+  return spline::KnotVector::from_breakpoints(oc, keep);
+}
+
+/// Gauss points, order + 1 per non-empty span: Schoenberg-Whitney holds, the fit is well posed.
+std::vector<double> samples(const spline::KnotVector& kv) {
+  const auto g = geom::gauss_legendre(kv.order() + 1);
+  const auto br = kv.breakpoints();
+  std::vector<double> t;
+  for (std::size_t s = 0; s + 1 < br.size(); ++s) {
+    const double a = br[s].value, b = br[s + 1].value;
+    for (double x : g.nodes) t.push_back(a + 0.5 * (x + 1.0) * (b - a));
+  }
+  return t;
+}
+
+/// (B^T B)^-1 B^T for the collocation matrix B of kv at t, without the first `skip` columns.
+Matrix pseudo_inverse(const spline::KnotVector& kv, const std::vector<double>& t, int skip) {
+  const int n = kv.size() - skip, ns = static_cast<int>(t.size()), o = kv.order();
+  Matrix B(ns, n);
+  std::vector<double> N(static_cast<std::size_t>(o));
+  for (int r = 0; r < ns; ++r) {
+    const int span = kv.find_span(t[static_cast<std::size_t>(r)]);
+    kv.basis(span, t[static_cast<std::size_t>(r)], N.data());
+    for (int k = 0; k < o; ++k) {
+      const int col = span - o + 1 + k - skip;
+      if (col >= 0) B(r, col) = N[static_cast<std::size_t>(k)];
+    }
+  }
+  // Normal equations, Cholesky (B has full column rank: Gauss points per span).
+  Matrix A(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j <= i; ++j) {
+      double s = 0.0;
+      for (int r = 0; r < ns; ++r) s += B(r, i) * B(r, j);
+      A(i, j) = A(j, i) = s;
+    }
+  for (int j = 0; j < n; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= A(j, k) * A(j, k);
+    if (!(d > 0)) throw Error("Shepard encoding: the fit space's normal equations are singular", ErrorKind::failed);
+    A(j, j) = std::sqrt(d);
+    for (int i = j + 1; i < n; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= A(i, k) * A(j, k);
+      A(i, j) = s / A(j, j);
+    }
+  }
+  Matrix P(n, ns);  // solve L L^T P = B^T, column by column
+  std::vector<double> x(static_cast<std::size_t>(n));
+  for (int r = 0; r < ns; ++r) {
+    for (int i = 0; i < n; ++i) {
+      double s = B(r, i);
+      for (int k = 0; k < i; ++k) s -= A(i, k) * x[static_cast<std::size_t>(k)];
+      x[static_cast<std::size_t>(i)] = s / A(i, i);
+    }
+    for (int i = n - 1; i >= 0; --i) {
+      double s = x[static_cast<std::size_t>(i)];
+      for (int k = i + 1; k < n; ++k) s -= A(k, i) * x[static_cast<std::size_t>(k)];
+      x[static_cast<std::size_t>(i)] = s / A(i, i);
+    }
+    for (int i = 0; i < n; ++i) P(i, r) = x[static_cast<std::size_t>(i)];
+  }
+  return P;
+}
+
+/// data[x0][x1][x2][h] (x0 slowest) times P along `axis`: that extent becomes P.rows.
+std::vector<double> mode_product(const std::vector<double>& data, std::array<int, 3>& dims, int m, int axis, const Matrix& P) {
+  std::array<int, 3> nd = dims;
+  nd[static_cast<std::size_t>(axis)] = P.rows;
+  std::vector<double> out(static_cast<std::size_t>(nd[0]) * nd[1] * nd[2] * m, 0.0);
+  const auto at = [m](const std::array<int, 3>& d, int i0, int i1, int i2) {
+    return ((static_cast<std::size_t>(i0) * d[1] + i1) * d[2] + i2) * static_cast<std::size_t>(m);
+  };
+  for (int i0 = 0; i0 < nd[0]; ++i0)
+    for (int i1 = 0; i1 < nd[1]; ++i1)
+      for (int i2 = 0; i2 < nd[2]; ++i2) {
+        double* o = out.data() + at(nd, i0, i1, i2);
+        const int row = axis == 0 ? i0 : axis == 1 ? i1 : i2;
+        for (int c = 0; c < P.cols; ++c) {
+          const double w = P(row, c);
+          if (w == 0.0) continue;
+          const int j0 = axis == 0 ? c : i0, j1 = axis == 1 ? c : i1, j2 = axis == 2 ? c : i2;
+          const double* s = data.data() + at(dims, j0, j1, j2);
+          for (int h = 0; h < m; ++h) o[h] += w * s[h];
+        }
+      }
+  dims = nd;
+  return out;
+}
+
+}  // namespace
+
+ShepardEncoding encode_shepard(const spline::Trivariate& half, const ShepardField& field, const ShepardOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int m = field.properties(), dim = 3 + m;
+  if (half.dim() != dim)
+    throw Error("Shepard encoding: the half has " + std::to_string(half.dim()) + " coordinates; expected " +
+                std::to_string(dim) + " (xyz and the Shepard surfaces' properties)");
+  if (half.rational()) throw Error("Shepard encoding: the half is rational; expected a polynomial fillet half");
+  if (opt.w_spans < 1 || opt.w_spans > 16 || opt.w_order < 2 || opt.w_order > 8 || opt.max_spans < 1 || opt.max_direct < 1)
+    throw Error("Shepard encoding: options out of range (w_spans 1..16, w_order 2..8, max_spans and max_direct >= 1)");
+  ShepardEncoding out;
+  if (m == 0) {
+    out.half = half;
+    return out;
+  }
+  const auto dw = half.domain(2);
+  const std::array<spline::KnotVector, 3> fk{fit_space(half.knots(0), opt), fit_space(half.knots(1), opt),
+                                             spline::KnotVector::uniform(opt.w_order, opt.w_spans, dw[0], dw[1])};
+  const std::array<std::vector<double>, 3> s{samples(fk[0]), samples(fk[1]), samples(fk[2])};
+  const std::array<int, 3> ns{static_cast<int>(s[0].size()), static_cast<int>(s[1].size()), static_cast<int>(s[2].size())};
+  // f and G (the half's own properties on w = 0) at every sample; one walk per u sample, cold
+  // at its start: the values do not depend on the thread count.
+  const std::size_t total = static_cast<std::size_t>(ns[0]) * ns[1] * ns[2];
+  std::vector<double> f(total * m), r(total * m);
+  tbb::parallel_for(0, ns[0], [&](int a) {
+    ShepardWalk walk;
+    std::vector<double> x(static_cast<std::size_t>(dim)), g(static_cast<std::size_t>(dim));
+    for (int b = 0; b < ns[1]; ++b) {
+      half.eval({s[0][a], s[1][b], dw[0]}, g.data());
+      for (int cc = 0; cc < ns[2]; ++cc) {
+        const int c = b % 2 == 0 ? cc : ns[2] - 1 - cc;  // serpentine: neighbours stay close
+        const std::size_t at = ((static_cast<std::size_t>(a) * ns[1] + b) * ns[2] + c) * m;
+        half.eval({s[0][a], s[1][b], s[2][c]}, x.data());
+        field.eval({x[0], x[1], x[2]}, f.data() + at, &walk);
+        for (int h = 0; h < m; ++h) r[at + h] = f[at + h] - g[static_cast<std::size_t>(3 + h)];
+      }
+    }
+  });
+  out.samples = static_cast<std::int64_t>(total);
+  // Least squares on the tensor grid: the Kronecker product of the 1-D pseudo-inverses; R's
+  // first layer along w (the face w = 0) is pinned to zero.
+  std::array<int, 3> dims = ns;
+  std::vector<double> c = mode_product(r, dims, m, 0, pseudo_inverse(fk[0], s[0], 0));
+  c = mode_product(c, dims, m, 1, pseudo_inverse(fk[1], s[1], 0));
+  c = mode_product(c, dims, m, 2, pseudo_inverse(fk[2], s[2], 1));
+  const int nu = fk[0].size(), nv = fk[1].size(), nw = fk[2].size();
+  std::vector<double> pts(static_cast<std::size_t>(nu) * nv * nw * m, 0.0);
+  for (int k = 1; k < nw; ++k)
+    for (int j = 0; j < nv; ++j)
+      for (int i = 0; i < nu; ++i)
+        for (int h = 0; h < m; ++h)
+          pts[(static_cast<std::size_t>(i) + static_cast<std::size_t>(nu) * (j + static_cast<std::size_t>(nv) * k)) * m + h] =
+              c[((static_cast<std::size_t>(i) * nv + j) * (nw - 1) + (k - 1)) * m + h];
+  out.fit_counts = {nu, nv, nw};
+  const spline::Trivariate R(fk, m, std::move(pts));
+  auto [H, Rc] = spline::make_compatible(half, R);
+  // Properties G + R; the face w = 0 (xyz and properties) is the half's own, bit for bit, when
+  // its u and v spaces are unchanged (the usual case), else the compatible half's.
+  const bool same_uv = H.knots(0) == half.knots(0) && H.knots(1) == half.knots(1);
+  const int hu = H.count(0), hv = H.count(1), hw = H.count(2);
+  for (int j = 0; j < hv; ++j)
+    for (int i = 0; i < hu; ++i) {
+      std::vector<double> base(static_cast<std::size_t>(dim));
+      const auto b0 = same_uv ? half.point(half.row({i, j, 0})) : H.point(H.row({i, j, 0}));
+      std::copy(b0.begin(), b0.end(), base.begin());
+      for (int k = 0; k < hw; ++k) {
+        auto p = H.point(H.row({i, j, k}));
+        if (k == 0) {
+          std::copy(base.begin(), base.end(), p.begin());
+          continue;
+        }
+        const auto rr = Rc.point(Rc.row({i, j, k}));
+        for (int h = 0; h < m; ++h) p[static_cast<std::size_t>(3 + h)] = base[static_cast<std::size_t>(3 + h)] + rr[static_cast<std::size_t>(h)];
+      }
+    }
+  // Errors at the samples and at midpoints between them.
+  double se = 0.0, me = 0.0;
+  std::vector<double> x(static_cast<std::size_t>(dim));
+  for (int a = 0; a < ns[0]; ++a)
+    for (int b = 0; b < ns[1]; ++b)
+      for (int cc = 0; cc < ns[2]; ++cc) {
+        const std::size_t at = ((static_cast<std::size_t>(a) * ns[1] + b) * ns[2] + cc) * m;
+        H.eval({s[0][a], s[1][b], s[2][cc]}, x.data());
+        for (int h = 0; h < m; ++h) {
+          const double e = std::abs(x[static_cast<std::size_t>(3 + h)] - f[at + h]);
+          me = std::max(me, e);
+          se += e * e;
+        }
+      }
+  out.max_error = me;
+  out.rms_error = std::sqrt(se / static_cast<double>(total * m));
+  const auto mid = [](const std::vector<double>& t, int k) { return 0.5 * (t[static_cast<std::size_t>(k)] + t[static_cast<std::size_t>(k) + 1]); };
+  std::vector<double> check(static_cast<std::size_t>(std::max(0, ns[0] - 1)), 0.0);
+  tbb::parallel_for(0, ns[0] - 1, [&](int a) {
+    ShepardWalk walk;
+    std::vector<double> y(static_cast<std::size_t>(dim)), fv(static_cast<std::size_t>(m));
+    double e = 0.0;
+    for (int b = 0; b + 1 < ns[1]; ++b)
+      for (int cc = 0; cc + 1 < ns[2]; ++cc) {
+        const int c = b % 2 == 0 ? cc : ns[2] - 2 - cc;
+        H.eval({mid(s[0], a), mid(s[1], b), mid(s[2], c)}, y.data());
+        field.eval({y[0], y[1], y[2]}, fv.data(), &walk);
+        for (int h = 0; h < m; ++h) e = std::max(e, std::abs(y[static_cast<std::size_t>(3 + h)] - fv[static_cast<std::size_t>(h)]));
+      }
+    check[static_cast<std::size_t>(a)] = e;
+  });
+  for (double e : check) out.check_error = std::max(out.check_error, e);
+  out.half = std::move(H);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace trivox::fillet
