@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "trivox/construct/constructors.hpp"
+#include "fillet_util.hpp"
 #include "trivox/error.hpp"
 #include "trivox/spline/fit.hpp"
 
@@ -18,7 +19,8 @@ using spline::Breakpoint;
 using spline::Curve;
 using spline::KnotVector;
 using spline::Surface;
-using Vec = std::array<double, 3>;
+using detail::Vec;
+using namespace detail;
 
 const char* section_name(Section s) noexcept { return s == Section::hermite ? "hermite" : "flend"; }
 
@@ -32,21 +34,6 @@ bool section_from_name(const char* name, Section& out) noexcept {
 }
 
 namespace {
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
-
-Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec add(const Vec& a, const Vec& b, double s = 1.0) { return {a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]}; }
-Vec scale(const Vec& a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
 
 /// The point (and derivative) of a curve in R^>=3 at t, xyz only.
 void curve_at(const Curve& c, double t, Vec& p, Vec* d = nullptr) {
@@ -79,14 +66,6 @@ Vec face_normal(const Surface& face, const Curve& rail_uv, double t) {
 KnotVector cubic_on(std::vector<Breakpoint> breaks) {
   for (std::size_t i = 1; i + 1 < breaks.size(); ++i) breaks[i].multiplicity = 1;
   return KnotVector::from_breakpoints(4, breaks);
-}
-
-KnotVector halved(const KnotVector& k) {
-  std::vector<double> all = k.knots();
-  const auto breaks = k.breakpoints();
-  for (std::size_t i = 0; i + 1 < breaks.size(); ++i) all.push_back(0.5 * (breaks[i].value + breaks[i + 1].value));
-  std::sort(all.begin(), all.end());
-  return KnotVector(k.order(), all);
 }
 
 /// A field along t in R^3 interpolated at the Greville points of `start`, its spans halved until
@@ -232,7 +211,7 @@ Surface blending_surface(const BlendInput& in, const BlendOptions& o, BlendRepor
                         num(t) + " (determinant " + num(det) + ")",
                     ErrorKind::failed);
       const double d1 = dot(n1, a), d2 = dot(n2, b), d3 = dot(n3, c);
-      return scale(add(add(scale(cross(n2, n3), d1), cross(n3, n1), d2), cross(n1, n2), d3), 1.0 / det);
+      return scale(axpy(axpy(scale(cross(n2, n3), d1), d2, cross(n3, n1)), d3, cross(n1, n2)), 1.0 / det);
     };
     const auto error = [&](double t, const Vec& pi) -> std::array<double, 2> {
       Vec a, b;
@@ -253,9 +232,9 @@ Surface blending_surface(const BlendInput& in, const BlendOptions& o, BlendRepor
         p4[static_cast<std::size_t>(k)] = c[1].point(j)[static_cast<std::size_t>(k)];
         pi[static_cast<std::size_t>(k)] = c[2].point(j)[static_cast<std::size_t>(k)];
       }
-      const Vec p1 = add(p0, sub(pi, p0), d), p3 = add(p4, sub(pi, p4), d);
-      const Vec ps = add(p1, sub(pi, p1), d), pss = add(p3, sub(pi, p3), d);
-      const Vec p2 = scale(add(ps, pss), 0.5);
+      const Vec p1 = axpy(p0, d, sub(pi, p0)), p3 = axpy(p4, d, sub(pi, p4));
+      const Vec ps = axpy(p1, d, sub(pi, p1)), pss = axpy(p3, d, sub(pi, p3));
+      const Vec p2 = scale(axpy(ps, 1.0, pss), 0.5);
       const Vec all[5] = {p0, p1, p2, p3, p4};
       for (int r = 0; r < 5; ++r)
         for (int k = 0; k < 3; ++k)

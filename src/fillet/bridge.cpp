@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "trivox/construct/constructors.hpp"
+#include "fillet_util.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/surface_intersection.hpp"
 #include "trivox/spline/calculus.hpp"
@@ -18,21 +19,10 @@ namespace trivox::fillet {
 using spline::KnotVector;
 using spline::Surface;
 using spline::Trivariate;
-using Vec = std::array<double, 3>;
+using detail::Vec;
+using namespace detail;
 
 namespace {
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
-
-Vec sub(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec axpy(const Vec& a, double s, const Vec& b) { return {a[0] + s * b[0], a[1] + s * b[1], a[2] + s * b[2]}; }
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
-Vec xyz(const std::vector<double>& p) { return {p[0], p[1], p[2]}; }
 
 /// The face's (u, v) transformed: swapped, then reversed in u and/or v.
 Surface oriented(Surface s, int code) {
@@ -105,16 +95,6 @@ Rows section(const Vec& pa, Vec da, const Vec& pb, Vec db, double dip, double u,
 double angle(const Vec& x, const Vec& unit) {
   const double l = norm(x);
   return l > 0.0 ? std::acos(std::clamp(dot(x, unit) / l, -1.0, 1.0)) : 0.0;
-}
-
-KnotVector halved(const KnotVector& k) {
-  std::vector<double> add;
-  const auto br = k.breakpoints();
-  for (std::size_t i = 0; i + 1 < br.size(); ++i) add.push_back(0.5 * (br[i].value + br[i + 1].value));
-  std::vector<double> all = k.knots();
-  all.insert(all.end(), add.begin(), add.end());
-  std::sort(all.begin(), all.end());
-  return KnotVector(k.order(), all);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "trivox/construct/constructors.hpp"
+#include "fillet_util.hpp"
 #include "trivox/error.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/spline/fit.hpp"
@@ -19,14 +20,10 @@ using spline::Breakpoint;
 using spline::Curve;
 using spline::KnotVector;
 using spline::Surface;
+using detail::halved;
+using detail::num;
 
 namespace {
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 /// The space of s o r along one direction of r: degree (p + q) * deg_r, each interior
 /// breakpoint of r keeping r's continuity there.
@@ -159,17 +156,6 @@ std::vector<double> sample_params(const KnotVector& k, int per_span) {
   }
   t.push_back(breaks.back().value);
   return t;
-}
-
-/// Knots with every span halved.
-KnotVector halved(const KnotVector& k) {
-  std::vector<double> mids;
-  const auto breaks = k.breakpoints();
-  for (std::size_t i = 0; i + 1 < breaks.size(); ++i) mids.push_back(0.5 * (breaks[i].value + breaks[i + 1].value));
-  std::vector<double> all = k.knots();
-  all.insert(all.end(), mids.begin(), mids.end());
-  std::sort(all.begin(), all.end());
-  return KnotVector(k.order(), all);
 }
 
 double xyz_distance(const double* a, const double* b, int dim) {

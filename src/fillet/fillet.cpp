@@ -7,6 +7,7 @@
 #include <limits>
 #include <string>
 
+#include "fillet_util.hpp"
 #include "trivox/error.hpp"
 #include "trivox/fillet/rails.hpp"
 #include "trivox/fillet/ruled_fillet.hpp"
@@ -20,7 +21,8 @@ using spline::Curve;
 using spline::Face;
 using spline::Surface;
 using spline::Trivariate;
-using Vec = std::array<double, 3>;
+using detail::Vec;
+using namespace detail;
 
 std::string FilletQuality::jacobian() const {
   if (det_min > 0.0) return "positive";
@@ -29,18 +31,6 @@ std::string FilletQuality::jacobian() const {
 }
 
 namespace {
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
-
-Vec cross(const double* a, const double* b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
 
 template <int P>
 SplineShape shape(const spline::TensorSpline<P>& s) {
@@ -56,7 +46,7 @@ SplineShape shape(const spline::TensorSpline<P>& s) {
 Vec unit_normal(const Surface& s, double u, double v, Vec* across = nullptr) {
   const auto d = s.eval_derivatives({u, v}, 1);
   const std::size_t k = static_cast<std::size_t>(s.dim());
-  Vec n = cross(d.data() + k, d.data() + 2 * k);
+  Vec n = cross(xyz(d.data() + k), xyz(d.data() + 2 * k));
   if (across) *across = {d[2 * k], d[2 * k + 1], d[2 * k + 2]};
   const double len = norm(n);
   if (len > 0.0)
@@ -120,7 +110,7 @@ void measure(const std::array<const Surface*, 2>& faces, const std::array<Curve,
         for (int c = 0; c < n2; ++c) {
           const auto d = h.eval_derivatives({(a + 0.5) / n0, (b + 0.5) / n1, (c + 0.5) / n2}, 1);
           const std::size_t kk = static_cast<std::size_t>(h.dim());
-          const double det = dot({d[kk], d[kk + 1], d[kk + 2]}, cross(d.data() + 2 * kk, d.data() + 3 * kk));
+          const double det = dot({d[kk], d[kk + 1], d[kk + 2]}, cross(xyz(d.data() + 2 * kk), xyz(d.data() + 3 * kk)));
           q.det_min = std::min(q.det_min, det);
           q.det_max = std::max(q.det_max, det);
         }
@@ -141,7 +131,7 @@ double outward_sign(const Trivariate& cell, Face face) {
   int others[2], n = 0;
   for (int d = 0; d < 3; ++d)
     if (d != dir) others[n++] = d;
-  const Vec normal = cross(der.data() + k * (1 + others[0]), der.data() + k * (1 + others[1]));
+  const Vec normal = cross(xyz(der.data() + k * (1 + others[0])), xyz(der.data() + k * (1 + others[1])));
   const double* inward = der.data() + k * (1 + dir);
   const double s = dot(normal, {inward[0], inward[1], inward[2]}) * (at_max ? 1.0 : -1.0);
   if (s == 0.0)
