@@ -21,8 +21,8 @@ std::array<double, 2> shepard_weights(double d1, double d2, int q) noexcept {
   const double r = first ? d1 / d2 : d2 / d1;
   double t = 1.0;
   for (int k = 0; k < q; ++k) t *= r;
-  const double near = 1.0 / (1.0 + t);
-  return first ? std::array<double, 2>{near, 1.0 - near} : std::array<double, 2>{1.0 - near, near};
+  const double near = 1.0 / (1.0 + t), far = t / (1.0 + t);  // each to full relative precision
+  return first ? std::array<double, 2>{near, far} : std::array<double, 2>{far, near};
 }
 
 namespace {

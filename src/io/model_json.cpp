@@ -164,7 +164,10 @@ std::vector<Item> read_items(const Source& src, const json& root, const char* li
     std::string name = read_name(src, item, ip, names);
     out.push_back({std::move(name),
                    read_spline<P>(src, require(src, item, ip, key, what), child(ip, key), shape)});
-    if constexpr (P == 3) read_trims(src, item, ip, shape, out.back(), 0);
+    if constexpr (P == 3) {
+      read_trims(src, item, ip, shape, out.back(), 0);
+      read_shepard(src, item, ip, shape, out.back());
+    }
   }
   return out;
 }

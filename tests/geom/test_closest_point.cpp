@@ -48,3 +48,33 @@ TEST_CASE("closest points on a planar patch and a cylinder", "[closest_point]") 
     CHECK(std::abs(rr[0] * d[3] + rr[1] * d[4] + rr[2] * d[5]) < 1e-7 * (1 + c.distance) * std::hypot(d[3], d[4], d[5]));
   }
 }
+
+TEST_CASE("warm-started closest points agree with cold ones", "[closest_point]") {
+  // Along a walk of nearby points, Newton from the previous answer's (u, v) reaches the cold
+  // query's point: same distance, same parameters to rounding.
+  spline::Curve line({KnotVector::bezier(2)}, 3, std::vector<double>{2, 0, 0, 2, 0, 3});
+  construct::Revolution rev;
+  rev.relative_tolerance = 1e-10;
+  const geom::SurfaceDistance cd(construct::revolve(line, rev));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  std::array<double, 3> p{3.0, 0.5, 1.0};
+  auto prev = cd.closest(p);
+  double worst_d = 0.0, worst_uv = 0.0;
+  for (int n = 0; n < 2000; ++n) {
+    p = {p[0] + 0.02 * U(rng), p[1] + 0.02 * U(rng), std::clamp(p[2] + 0.02 * U(rng), 0.2, 2.8)};
+    std::vector<double> values(3);
+    const auto w = cd.closest(p, prev.uv, values.data());
+    const auto c = cd.closest(p);
+    CHECK(w.converged);
+    worst_d = std::max(worst_d, std::abs(w.distance - c.distance));
+    worst_uv = std::max({worst_uv, std::abs(w.uv[0] - c.uv[0]), std::abs(w.uv[1] - c.uv[1])});
+    CHECK(values == std::vector<double>(w.point.begin(), w.point.end()));
+    prev = w;
+  }
+  CHECK(worst_d < 1e-13);
+  CHECK(worst_uv < 1e-11);
+  // A start outside the domain is clamped into it.
+  const auto c = cd.closest({3.0, 0.0, 1.0}, {-5.0, 9.0});
+  CHECK(c.distance == Approx(1.0).margin(1e-8));
+}

@@ -10,7 +10,8 @@
 ///     alpha_i(p) = d_i^-q / (d_1^-q + d_2^-q),   f(p) = alpha_1 g_1(pi_1(p)) + alpha_2 g_2(pi_2(p)),
 ///
 /// q a positive integer. The weights are computed as alpha_1 = 1 / (1 + (d_1 / d_2)^q) when
-/// d_1 <= d_2 (and symmetrically), alpha_2 = 1 - alpha_1: no division by zero on S^_i, where
+/// d_1 <= d_2, alpha_2 = t / (1 + t) with t = (d_1 / d_2)^q (and symmetrically): no division by
+/// zero on S^_i, where
 /// alpha_i = 1 exactly (Eq. 9a, feature preservation), alpha_1 + alpha_2 = 1 (Eq. 9b) and both in
 /// [0, 1] (Eq. 9c). On the intersection curve C both distances vanish and f is not continuous
 /// there when g_1 != g_2 on C (seed 000 Sec. 7.1 notes the same of the parametric blend); there
