@@ -476,6 +476,7 @@ KernelResult<P> kernel_based(const TensorSpline<P>& s0, const KernelConstructOpt
     r.iterations = i;
     r.point = k;
     r.fitted = false;
+    r.spread_width = o.spread * size;
     bool ok = accepted(s, orientation, o);
     if (!ok && o.kernel_point == KernelPoint::fitted)
       if (const auto f = fitted_point<P>(s, fit_kern, k, o.spread * size, orientation, o.fit_subdivisions)) {
@@ -484,6 +485,17 @@ KernelResult<P> kernel_based(const TensorSpline<P>& s0, const KernelConstructOpt
         r.point = *f;
         r.fitted = true;
       }
+    if (!ok && o.kernel_point == KernelPoint::fitted && o.retry_spread > 0 && o.spread != o.retry_spread) {
+      // Sec. 6 as a last try at this iteration: the interior on a grid around the fitted point.
+      const double width = o.retry_spread * size;
+      if (const auto f = fitted_point<P>(s, fit_kern, k, width, orientation, o.fit_subdivisions)) {
+        move_interior<P>(s, *f, width, orientation);
+        ok = accepted(s, orientation, o);
+        r.point = *f;
+        r.fitted = true;
+        r.spread_width = width;
+      }
+    }
     r.spline = std::move(s);
     if (ok) {
       r.valid = true;

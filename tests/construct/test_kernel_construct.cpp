@@ -339,3 +339,42 @@ TEST_CASE("KernelPoint::fitted: a kernel point where det J's coefficients allow 
     CHECK(r.spline.point(row)[1] == (*r.point)[1]);
   }
 }
+
+TEST_CASE("KernelConstructOptions::retry_spread: the Sec. 6 grid around the fitted point as a last try", "[kernel]") {
+  // From the Sec. 5.1 generator (rounded): neither the centroid nor a single fitted point gives
+  // det J >= 0 at iteration 0; the interior spread on a small grid around a fitted centre does.
+  const std::vector<Curve> c{cubic({{-1, -1}, {0.92, -1.77}, {0.61, -1.26}, {1, -1}}),
+                             cubic({{-1, 1}, {1.94, 1.77}, {-1.82, 0.20}, {1, 1}}),
+                             cubic({{-1, -1}, {-1.47, 0.22}, {-1.03, 0.98}, {-1, 1}}),
+                             cubic({{1, -1}, {0.74, -0.26}, {1.15, -0.42}, {1, 1}})};
+  construct::KernelConstructOptions o;
+  o.max_dof = 0;
+  o.kernel_point = construct::KernelPoint::fitted;
+  const auto single = construct::kernel_construct(KernelOp::boolean_sum, c, o);
+  REQUIRE(single.kernel.has_value());
+  CHECK_FALSE(single.valid);
+  CHECK(single.spread_width == 0.0);
+  CHECK(det_range(single.spline)[0] < 0.0);
+
+  o.retry_spread = 0.5;
+  const auto r = construct::kernel_construct(KernelOp::boolean_sum, c, o);
+  REQUIRE(r.valid);
+  CHECK(r.iterations == 0);
+  CHECK(r.fitted);
+  CHECK(r.spread_width == Approx(0.5 * std::sqrt(r.kernel_measure)));
+  const auto range = det_range(r.spline);
+  CHECK(range[0] >= -1e-12 * range[1]);
+  CHECK(r.strictly_valid == (geom::check_validity(r.spline).verdict == geom::Validity::valid));
+  check_boolean_sum_boundaries(r.spline, c);
+  // The interior points are distinct (a grid), centred at the fitted point.
+  double cx = 0.0, cy = 0.0;
+  int n = 0;
+  for (int row = 0; row < r.spline.size(); ++row) {
+    const auto ij = r.spline.multi_index(row);
+    if (ij[0] == 0 || ij[1] == 0 || ij[0] == r.spline.count(0) - 1 || ij[1] == r.spline.count(1) - 1) continue;
+    cx += r.spline.point(row)[0], cy += r.spline.point(row)[1], ++n;
+  }
+  CHECK(cx / n == Approx((*r.point)[0]).margin(1e-12));
+  CHECK(cy / n == Approx((*r.point)[1]).margin(1e-12));
+  CHECK(r.spline.point(r.spline.row({1, 1}))[0] != r.spline.point(r.spline.row({2, 2}))[0]);
+}

@@ -94,6 +94,11 @@ struct KernelConstructOptions {
   /// than `kernel` (still inside the true kernel: refinement only grows the conservative kernel
   /// towards it). Trivariates use `kernel` (each 3-D refinement quadruples a face's constraints).
   geom::KernelOptions fit_kernel{6};
+  /// KernelPoint::fitted: when neither the centroid nor the fitted point is accepted at an
+  /// iteration, one more try before adding freedom: the interior points on the Sec. 6 grid,
+  /// `retry_spread` x kernel size wide, centred at the point fitted for that grid (det J stays
+  /// affine in the centre). 0: no retry.
+  double retry_spread = 0.0;
   int ruling_order = 3;             ///< order of the ruling direction (seed 004 Sec. 5.1: 3)
   geom::KernelOptions kernel{};     ///< refinement of the kernel computation
   geom::ValidityOptions validity{}; ///< subdivision limits of the validity checks
@@ -115,6 +120,9 @@ struct KernelResult {
   /// fitted point (KernelPoint::fitted; then `fitted` is true). Empty when no kernel.
   std::optional<std::array<double, P>> point;
   bool fitted = false;
+  /// The width of the Sec. 6 grid the result's interior points were spread over (0: all at
+  /// `point`): spread x kernel size, or retry_spread x kernel size when the retry was taken.
+  double spread_width = 0.0;
   /// The result meets options.acceptance (or the regular construction was valid).
   bool valid = false;
   /// The result is also strictly valid (geom::check_validity: det J > 0 everywhere).
