@@ -120,6 +120,17 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                     {"fillet", shape(q2.fillet)},
                     {"seconds", q2.seconds}});
     }
+  nlohmann::ordered_json jb = nlohmann::ordered_json::array();
+  for (const auto& b : built.bridges)
+    jb.push_back({{"name", b.name},
+                  {"cell", b.cell_name},
+                  {"between", {{{"cell", b.cells[0]}, {"face", spline::face_name(b.faces[0])}},
+                               {{"cell", b.cells[1]}, {"face", spline::face_name(b.faces[1])}}}},
+                  {"orientation", b.quality.orientation},
+                  {"g1_angle", b.quality.g1_angle},
+                  {"min_jacobian", b.quality.det_min},
+                  {"max_jacobian", b.quality.det_max},
+                  {"seconds", b.seconds}});
   return {{"scene", opt.scene},
           {"model", opt.output},
           {"units", built.model.units},
@@ -128,7 +139,8 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
           {"volume", total},
           {"cells", jc},
           {"primitives", jp},
-          {"fillets", jf}};
+          {"fillets", jf},
+          {"bridges", jb}};
 }
 
 void print_human(const nlohmann::ordered_json& j) {
@@ -171,6 +183,18 @@ void print_human(const nlohmann::ordered_json& j) {
                   fmt(mx("gap"), 3).c_str(), fmt(mx("g1_angle"), 3).c_str(), fmt(mx("property_jump"), 3).c_str(),
                   f["jacobian"].get<std::string>().c_str(), c0 && c1 ? "composed" : (c0 || c1 ? "mixed" : "fitted"),
                   fmt(f["seconds"].get<double>(), 3).c_str());
+    }
+  }
+  if (!j["bridges"].empty()) {
+    std::printf("\n%-14s %-26s %-22s %11s %8s\n", "bridge", "between", "B matched", "G1 (rad)", "seconds");
+    for (const auto& b : j["bridges"]) {
+      const auto& bt = b["between"];
+      const std::string between = bt[0]["cell"].get<std::string>() + "." + bt[0]["face"].get<std::string>() + "/" +
+                                  bt[1]["cell"].get<std::string>() + "." + bt[1]["face"].get<std::string>();
+      std::printf("%-14s %-26s %-22s %11s %8s\n", b["cell"].get<std::string>().c_str(), between.c_str(),
+                  b["orientation"].get<std::string>().c_str(),
+                  fmt(std::max(b["g1_angle"][0].get<double>(), b["g1_angle"][1].get<double>()), 3).c_str(),
+                  fmt(b["seconds"].get<double>(), 3).c_str());
     }
   }
   std::printf("\ntotal volume %s; %s\n", fmt(j["volume"].get<double>(), 12).c_str(),

@@ -1,6 +1,7 @@
 #include "trivox/io/scene.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 
 #include "json_io.hpp"
@@ -206,7 +207,7 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
 void read_fillet(const Source& src, const json& item, const std::string& ip, SceneOperation& o) {
   const std::string what =
       "a fillet {\"op\": \"fillet\", \"between\": [A, B], \"distance\", \"tau\", \"section\", \"dip\", "
-      "\"method\", \"blend\", \"power\", \"flip\", \"name\"}";
+      "\"method\", \"blend\", \"power\", \"flip\", \"bridge\", \"name\"}";
   const std::string bp = child(ip, "between");
   const json& between = require(src, item, ip, "between", what);
   const std::string bwhat = "two cells: names or {\"cell\": NAME, \"face\": \"u0\"..\"w1\"}";
@@ -232,16 +233,31 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
   }
   if (o.between[0] == o.between[1]) src.fail(child(bp, 1), quote(o.between[1]) + " twice; expected two different cells");
   fillet::FilletOptions& f = o.fillet;
-  const json& d = require(src, item, ip, "distance", what);
-  const std::string dp = child(ip, "distance");
-  if (d.is_array()) {
-    if (d.size() != 2) fail_type(src, dp, d, "a distance or two [d1, d2]");
-    f.distance = {read_number_at(src, d[0], dp, 0), read_number_at(src, d[1], dp, 1)};
-  } else {
-    f.distance[0] = f.distance[1] = read_number(src, d, dp);
+  if (const json* b = find(item, "bridge")) {
+    if (!b->is_boolean()) fail_type(src, child(ip, "bridge"), *b, "true or false");
+    o.bridge = b->get<bool>();
   }
-  for (double x : f.distance)
-    if (!(x > 0.0)) src.fail(dp, "distance " + format_double(x) + "; expected positive distances (model units)");
+  if (o.bridge) {
+    // Flends Sec. III between disjoint faces: the faces, dip and name; no distances or tangents.
+    if (!o.faces[0] || !o.faces[1])
+      src.fail(bp, "a bridge names both faces; expected [{\"cell\", \"face\"}, {\"cell\", \"face\"}]");
+    for (const char* key : {"distance", "tau", "method", "flip", "blend", "power"})
+      if (find(item, key)) src.fail(child(ip, key), std::string("\"") + key + "\" with \"bridge\": true; expected "
+                                                         "only \"between\", \"section\": \"flend\", \"dip\" and \"name\"");
+    f.blend.section = fillet::Section::flend;
+  }
+  if (!o.bridge) {
+    const json& d = require(src, item, ip, "distance", what);
+    const std::string dp = child(ip, "distance");
+    if (d.is_array()) {
+      if (d.size() != 2) fail_type(src, dp, d, "a distance or two [d1, d2]");
+      f.distance = {read_number_at(src, d[0], dp, 0), read_number_at(src, d[1], dp, 1)};
+    } else {
+      f.distance[0] = f.distance[1] = read_number(src, d, dp);
+    }
+    for (double x : f.distance)
+      if (!(x > 0.0)) src.fail(dp, "distance " + format_double(x) + "; expected positive distances (model units)");
+  }
   if (const json* t = find(item, "tau")) {
     f.blend.tau = read_number(src, *t, child(ip, "tau"));
     if (!(f.blend.tau > 0.0 && f.blend.tau <= 10.0))
@@ -251,6 +267,8 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     const std::string sec = read_string(src, *t, child(ip, "section"), "\"hermite\" or \"flend\"");
     if (!fillet::section_from_name(sec.c_str(), f.blend.section))
       src.fail(child(ip, "section"), "unknown section " + quote(sec) + "; expected \"hermite\" or \"flend\"");
+    if (o.bridge && f.blend.section != fillet::Section::flend)
+      src.fail(child(ip, "section"), "a bridge is a flend (seed 002 Sec. III); expected \"section\": \"flend\"");
   }
   if (const json* t = find(item, "dip")) {
     f.blend.dip = read_number(src, *t, child(ip, "dip"));
@@ -362,6 +380,28 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
                     "trimmed cells are later work)");
     if (cell[i]->volume.rational())
       src.fail(ptr, quote(op.between[i]) + " is rational; expected a polynomial cell");
+  }
+  if (op.bridge) {
+    // Flends Sec. III: one cell from face to face (the reader made sure both faces are named).
+    BridgeBuild rep;
+    rep.name = op.name;
+    rep.pointer = op.pointer;
+    rep.cells = op.between;
+    rep.faces = {*op.faces[0], *op.faces[1]};
+    rep.cell_name = op.name + ".1";
+    const auto start = std::chrono::steady_clock::now();
+    spline::Trivariate t;
+    try {
+      t = fillet::bridge(cell[0]->volume, rep.faces[0], cell[1]->volume, rep.faces[1], {.dip = op.fillet.blend.dip},
+                         &rep.quality);
+    } catch (const Error& e) {
+      throw e.within(src.at(op.pointer));
+    }
+    rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::vector<vmodel::VCell> cells;
+    cells.emplace_back(rep.cell_name, std::move(t));
+    out.bridges.push_back(std::move(rep));
+    return cells;
   }
   std::array<spline::Face, 2> faces{};
   if (op.faces[0] && op.faces[1]) {

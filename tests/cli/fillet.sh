@@ -8,7 +8,7 @@
 # inside and outside the chamfer plane are in and out of the fillet, and the printed volume
 # counts the chamfer (32.5 mm^3 within 0.5 percent). The shipped models build.
 # Bad fillets exit 2 naming the operation and what is wrong; a fillet whose det J changes sign
-# exits 1 and is not written.
+# exits 1 and is not written. A bridge between disjoint boxes has the analytic volume.
 set -euo pipefail
 trivox=$1
 py=/usr/bin/python3
@@ -110,6 +110,35 @@ assert max(f["gap"]) < 1e-5 and max(f["g1_angle"]) < 1e-5, f
 assert r["valid"]
 PY
 done
+
+# A bridge (Flends Sec. III) between disjoint boxes, the second lifted by 1: its sections are
+# translates, so its volume is 1 x 2 x 1 = 2; at its centre the colour is half of each.
+cat > "$tmp/bridge.json" <<'EOF'
+{ "trivox": 1, "units": "mm", "properties": ["r", "g", "b"],
+  "cells": [
+    {"name": "a", "primitive": {"type": "box", "min": [0, 0, 0], "max": [1, 1, 1]}, "field": {"constant": [1, 0, 0]}},
+    {"name": "b", "primitive": {"type": "box", "min": [3, 0, 1], "max": [4, 1, 2]}, "field": {"constant": [0, 0, 1]}}
+  ],
+  "operations": [{"op": "fillet", "name": "link", "between": [{"cell": "a", "face": "u1"}, {"cell": "b", "face": "u0"}],
+                  "bridge": true, "dip": 0.4}] }
+EOF
+"$trivox" build "$tmp/bridge.json" -o "$tmp/bridge-model.json" --json > "$tmp/build.out"
+"$trivox" locate "$tmp/bridge-model.json" --xyz 2,0.5,1 --json > "$tmp/loc.out"
+"$py" - "$tmp/build.out" "$tmp/loc.out" <<'PY'
+import sys, json
+r, loc = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+(b,) = r["bridges"]
+assert b["cell"] == "link.1" and b["orientation"] == "as is", b
+assert max(b["g1_angle"]) < 1e-9 and b["min_jacobian"] > 0, b
+(cell,) = [c for c in r["cells"] if c["name"] == "link.1"]
+assert cell["verdict"] == "valid" and abs(cell["volume"] - 2.0) < 1e-12, cell
+assert loc["cell"] == "link.1", loc
+p = loc["properties"]
+assert abs(p["r"] - 0.5) < 1e-9 and abs(p["b"] - 0.5) < 1e-9, p
+PY
+sed -i 's/"bridge": true, "dip": 0.4/"bridge": true, "distance": 1/' "$tmp/bridge.json"
+expect_fail 'bridge.json: /operations/0/distance: "distance" with "bridge": true; expected only' \
+  "$trivox" build "$tmp/bridge.json" -o "$tmp/x.json"
 
 # Bad fillets: exit 2, the operation's place and what is wrong.
 corner '"distance": [2.5, 0.5]'

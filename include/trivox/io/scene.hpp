@@ -21,7 +21,9 @@
 /// "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric" | "shepard",
 /// "power": q (Shepard only, 1..16, default 2; fillet/shepard.hpp, seed 000 Sec. 7.2), "flip": bool |
 /// [bool, bool], "name"}, A and B cell names or {"cell": NAME, "face": "u0".."w1"}; without
-/// faces, the one pair of faces that intersects is used. The fillet's cells, two per
+/// faces, the one pair of faces that intersects is used. With "bridge": true (and both faces
+/// named) the fillet is a flend between disjoint faces instead (fillet/bridge.hpp, seed 002
+/// Sec. III): one cell `<name>.1` from face to face, with "dip". The fillet's cells, two per
 /// intersection component (`<name>.<k>a`, `<name>.<k>b`), are appended to the model; the
 /// filleted cells stay as they are. The constructors are later work: build_scene refuses them,
 /// naming them ("not supported yet"). An unknown name is refused by the reader, which lists the
@@ -39,6 +41,7 @@
 #include <vector>
 
 #include "trivox/construct/primitives.hpp"
+#include "trivox/fillet/bridge.hpp"
 #include "trivox/fillet/fillet.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
@@ -75,6 +78,7 @@ struct SceneOperation {
   std::array<std::string, 2> between;
   std::array<std::optional<spline::Face>, 2> faces;
   fillet::FilletOptions fillet;
+  bool bridge = false;      ///< "bridge": true: a flend between disjoint faces (fillet/bridge.hpp)
   bool shepard = false;     ///< "blend": "shepard" (seed 000 Sec. 7.2), else parametric (Sec. 7.1)
   int shepard_power = 2;    ///< "power": Shepard's q, 1..16
 };
@@ -126,10 +130,22 @@ struct FilletBuild {
   std::vector<ShepardFit> shepard;
 };
 
+/// What one bridge (a fillet operation with "bridge": true) gave: one cell.
+struct BridgeBuild {
+  std::string name;       ///< the operation's result name
+  std::string pointer;    ///< "/operations/<i>"
+  std::array<std::string, 2> cells;  ///< the bridged cells
+  std::array<spline::Face, 2> faces{};
+  std::string cell_name;  ///< the bridge's cell in the model, <name>.1
+  fillet::BridgeQuality quality;
+  double seconds = 0.0;
+};
+
 struct SceneBuild {
   vmodel::VModel model;
   std::vector<PrimitiveBuild> primitives;
   std::vector<FilletBuild> fillets;
+  std::vector<BridgeBuild> bridges;
 };
 
 /// Expands the primitives (named `<name>.<part>`, construct/primitives.hpp) and applies their
