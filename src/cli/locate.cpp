@@ -5,13 +5,15 @@
 #include "common.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/fillet/shepard.hpp"
 #include "trivox/slice/locator.hpp"
+#include "trivox/slice/sampler.hpp"
 
 namespace trivox::cli {
 
 namespace {
 struct Options {
-  std::string model, xyz;
+  std::string model, xyz, blend = "encoded";
   double tolerance = 1e-6;
 };
 }  // namespace
@@ -23,10 +25,15 @@ void add_locate(CLI::App& app, Common& common) {
   sub->add_option("--xyz", opt->xyz, "The point X,Y,Z in model units")->required();
   sub->add_option("--tolerance", opt->tolerance, "Distance in model units within which a point counts as on the cell")
       ->capture_default_str();
+  sub->add_option("--blend", opt->blend,
+                  "Shepard fillet cells: encoded (their control points, default) or shepard (the exact blend at the point)");
   sub->add_flag("--json", common.json, "Print one JSON object instead of the summary");
   sub->callback([opt, &common] {
     const auto model = io::load_model(opt->model);
     const auto p = parse_numbers(opt->xyz, 3, "--xyz");
+    slice::PropertyBlend blend{};
+    if (!slice::property_blend_from_name(opt->blend, blend))
+      throw Error("--blend " + opt->blend + ": unknown; expected encoded or shepard");
     if (!(opt->tolerance > 0.0 && opt->tolerance < 1e300))
       throw Error("--tolerance " + fmt(opt->tolerance, 17) + ": expected a positive finite distance");
     if (model.cells.empty())
@@ -51,6 +58,12 @@ void add_locate(CLI::App& app, Common& common) {
       std::copy(v.begin() + 3, v.end(), props.begin());
       // A Boolean's intersection cell blends its inputs' properties (VCell::blend).
       if (!props.empty()) locator.admits(r.cell, q, props.data());
+      // A Shepard fillet cell: f itself (seed 000 Sec. 7.2), cold closest points.
+      const auto& sd = model.cells[static_cast<std::size_t>(r.cell)].shepard;
+      if (blend == slice::PropertyBlend::shepard && sd && !props.empty()) {
+        const auto v = fillet::ShepardField(*sd).eval(q, props.data());
+        j["shepard"] = {{"alpha", v.alpha}, {"distance", v.distance}};
+      }
       j["cell"] = model.cells[static_cast<std::size_t>(r.cell)].name;
       j["uvw"] = r.uvw;
       j["point"] = x;

@@ -22,7 +22,7 @@ namespace trivox::cli {
 namespace {
 
 struct Options {
-  std::string model, out, printer = "j750", dpi, palette, dither = "fs", progress = "auto";
+  std::string model, out, printer = "j750", dpi, palette, dither = "fs", progress = "auto", blend = "encoded";
   double layer = 0.0;
   int threads = 0;
   bool zip = false, force = false;
@@ -137,6 +137,8 @@ void add_slice(CLI::App& app, Common& common) {
   sub->add_option("--layer", opt->layer, "Custom layer thickness in mm (overrides the preset)");
   sub->add_option("--palette", opt->palette, "Palette file (JSON); default: the Vero palette");
   sub->add_option("--dither", opt->dither, "fs (error diffusion, default), stochastic or none");
+  sub->add_option("--blend", opt->blend,
+                  "Shepard fillet cells: encoded (their control points, default) or shepard (the exact blend per voxel)");
   sub->add_flag("--zip", opt->zip, "Also pack the folder as <DIR>.gcvf");
   sub->add_flag("--force", opt->force, "Write into a non-empty folder; allow jobs beyond the tray or --max-voxels");
   sub->add_option("--max-voxels", opt->max_voxels, "Refuse larger grids unless --force (default 1e11)");
@@ -171,8 +173,12 @@ void add_slice(CLI::App& app, Common& common) {
     else if (sub->count("--shard-count"))
       throw Error("--shard-count " + std::to_string(opt->shard_count) +
                   ": without JOB_COMPLETION_INDEX in the environment; expected a Kubernetes Indexed Job, or --shard K/N");
+    slice::SamplerOptions sampling;
+    if (!slice::property_blend_from_name(opt->blend, sampling.blend))
+      throw Error("--blend " + opt->blend + ": unknown; expected encoded or shepard");
     const auto model = io::load_model(opt->model);
     io::VdbJobOptions vj;
+    vj.sampler = sampling;
     std::optional<io::VdbPlan> plan;
     if (want_vdb) {
       vj.out_dir = opt->out;
@@ -195,6 +201,8 @@ void add_slice(CLI::App& app, Common& common) {
                                                     static_cast<std::size_t>(opt->threads));
     // The manifest's identity of the job (manifest.hpp): the model's bytes and the VDB's options.
     std::map<std::string, std::string> vdb_options{{"vdb", want_vdb ? "yes" : "no"}};
+    // Part of the job's identity only when not the default, so earlier manifests still resume.
+    if (sampling.blend != slice::PropertyBlend::encoded) vdb_options["blend"] = slice::property_blend_name(sampling.blend);
     if (plan) {
       vdb_options["vdb.voxel_mm"] = io::option_number(plan->voxel_mm);
       vdb_options["vdb.supersample"] = std::to_string(plan->supersample);
@@ -273,6 +281,7 @@ void add_slice(CLI::App& app, Common& common) {
     job.max_voxels = opt->max_voxels;
     job.resume = opt->resume;
     job.shard = shard;
+    job.sampler = sampling;
     const std::optional<io::ManifestFile> vdb_done = verified_vdb();
     const auto s = io::run_slice_job(model, job, make_progress(opt->progress));
     std::optional<io::VdbJobSummary> v;

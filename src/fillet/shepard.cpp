@@ -113,8 +113,20 @@ struct Matrix {
 /// The fit space along u or v: the half's own for few control points, else order <= 4 on at
 /// most max_spans of its breakpoints, multiplicities lowered with the order so that the space
 /// elevated to the half's order lies in the half's (where the half is smooth enough to allow it).
-spline::KnotVector fit_space(const spline::KnotVector& kv, const ShepardOptions& opt) {
-  if (kv.size() <= opt.max_direct) return kv;
+spline::KnotVector fit_space(const spline::KnotVector& kv, const ShepardOptions& opt, bool graded) {
+  if (kv.size() <= opt.max_direct) {
+    if (!graded || opt.grade < 1) return kv;
+    // Across C (v): f turns from g_1 to g_2 around C within a small angle near it, so knots
+    // graded towards both ends of v (C is at one, the rail at the other): 1/2, 2^-k, 1 - 2^-k.
+    const double a = kv.front(), b = kv.back();
+    std::vector<double> add{0.5};
+    for (int k = 2; k <= opt.grade + 1; ++k) add.insert(add.end(), {std::ldexp(1.0, -k), 1.0 - std::ldexp(1.0, -k)});
+    std::vector<double> t = kv.knots();
+    for (double x : add)
+      if (kv.multiplicity(a + x * (b - a)) == 0) t.push_back(a + x * (b - a));
+    std::sort(t.begin(), t.end());
+    return spline::KnotVector(kv.order(), t);
+  }
   const int o = kv.order(), oc = std::min(4, o);
   const auto br = kv.breakpoints();
   const int spans = static_cast<int>(br.size()) - 1;
@@ -128,10 +140,13 @@ spline::KnotVector fit_space(const spline::KnotVector& kv, const ShepardOptions&
   return spline::KnotVector::from_breakpoints(oc, keep);
 }
 
-/// Gauss points, order + 1 per non-empty span: Schoenberg-Whitney holds, the fit is well posed.
+/// Gauss points per non-empty span: twice the functions per span (at least 2, at most order + 1),
+/// so every function's support holds several samples and the fit is well posed.
 std::vector<double> samples(const spline::KnotVector& kv) {
-  const auto g = geom::gauss_legendre(kv.order() + 1);
   const auto br = kv.breakpoints();
+  const int spans = static_cast<int>(br.size()) - 1;
+  const int per = std::clamp((2 * kv.size() + spans - 1) / spans, 2, kv.order() + 1);
+  const auto g = geom::gauss_legendre(per);
   std::vector<double> t;
   for (std::size_t s = 0; s + 1 < br.size(); ++s) {
     const double a = br[s].value, b = br[s + 1].value;
@@ -232,8 +247,12 @@ ShepardEncoding encode_shepard(const spline::Trivariate& half, const ShepardFiel
     return out;
   }
   const auto dw = half.domain(2);
-  const std::array<spline::KnotVector, 3> fk{fit_space(half.knots(0), opt), fit_space(half.knots(1), opt),
-                                             spline::KnotVector::uniform(opt.w_order, opt.w_spans, dw[0], dw[1])};
+  // Along w: breakpoints graded towards S^_i (w = 0), where f changes fastest near C.
+  std::vector<spline::Breakpoint> wb{{dw[0], opt.w_order}};
+  for (int k = opt.w_spans - 1; k >= 1; --k) wb.push_back({dw[0] + std::ldexp(1.0, -k) * (dw[1] - dw[0]), 1});
+  wb.push_back({dw[1], opt.w_order});
+  const std::array<spline::KnotVector, 3> fk{fit_space(half.knots(0), opt, false), fit_space(half.knots(1), opt, true),
+                                             spline::KnotVector::from_breakpoints(opt.w_order, wb)};
   const std::array<std::vector<double>, 3> s{samples(fk[0]), samples(fk[1]), samples(fk[2])};
   const std::array<int, 3> ns{static_cast<int>(s[0].size()), static_cast<int>(s[1].size()), static_cast<int>(s[2].size())};
   // f and G (the half's own properties on w = 0) at every sample; one walk per u sample, cold

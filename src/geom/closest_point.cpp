@@ -30,6 +30,17 @@ SurfaceDistance::SurfaceDistance(spline::Surface surface, int samples_per_span) 
   if (surface_.dim() < 3)
     throw Error("closest point on a surface with " + std::to_string(surface_.dim()) +
                 " coordinates; expected at least 3 (xyz)");
+  // Newton needs xyz only: a copy of the surface without its property coordinates halves the
+  // work per evaluation for a surface that carries three properties.
+  if (surface_.dim() == 3) {
+    geo_ = surface_;
+  } else {
+    const int n = surface_.size(), k = surface_.dim();
+    std::vector<double> xyz(static_cast<std::size_t>(3 * n));
+    for (int r = 0; r < n; ++r)
+      for (int d = 0; d < 3; ++d) xyz[static_cast<std::size_t>(3 * r + d)] = surface_.points()[static_cast<std::size_t>(k * r + d)];
+    geo_ = spline::Surface(surface_.knot_vectors(), 3, std::move(xyz), surface_.weights());
+  }
   samples_per_span = std::max(2, samples_per_span);
   const auto us = sample_params(surface_.knots(0), samples_per_span);
   const auto vs = sample_params(surface_.knots(1), samples_per_span);
@@ -61,8 +72,7 @@ ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p) const {
       best[k] = i;
     }
   }
-  const int dim = surface_.dim();
-  std::vector<double> buf(static_cast<std::size_t>(6 * dim)), val(static_cast<std::size_t>(dim));
+  std::vector<double> buf(6 * 3), val(3);
   ClosestPoint out;
   out.distance = std::numeric_limits<double>::infinity();
   const std::size_t starts = std::min<std::size_t>(3, xyz_.size());
@@ -71,7 +81,7 @@ ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p) const {
     double f = best_d[s];
     const bool conv = descend(p, t, f, buf.data(), val.data());
     if (std::sqrt(f) < out.distance) {
-      surface_.eval(t, val.data());
+      geo_.eval(t, val.data());
       out.uv = t;
       out.point = {val[0], val[1], val[2]};
       out.distance = std::sqrt(f);
@@ -83,45 +93,38 @@ ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p) const {
 
 ClosestPoint SurfaceDistance::closest(const std::array<double, 3>& p, const std::array<double, 2>& start,
                                       double* values) const {
-  const int dim = surface_.dim();
-  // Stack buffers for the common case (up to 16 coordinates), no allocation per query.
-  double sbuf[6 * 16], sval[16];
-  std::vector<double> hbuf, hval;
-  double* buf = sbuf;
-  double* val = sval;
-  if (dim > 16) {
-    hbuf.resize(static_cast<std::size_t>(6 * dim));
-    hval.resize(static_cast<std::size_t>(dim));
-    buf = hbuf.data();
-    val = hval.data();
-  }
-  const auto du = surface_.domain(0), dv = surface_.domain(1);
+  double buf[6 * 3], val[3];
+  const auto du = geo_.domain(0), dv = geo_.domain(1);
   std::array<double, 2> t{std::clamp(start[0], du[0], du[1]), std::clamp(start[1], dv[0], dv[1])};
-  surface_.eval(t, val);
+  geo_.eval(t, val);
   const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
   double f = dot3(r, r);
   ClosestPoint out;
   out.converged = descend(p, t, f, buf, val);
-  surface_.eval(t, val);
   out.uv = t;
-  out.point = {val[0], val[1], val[2]};
+  if (values) {
+    surface_.eval(t, values);
+    out.point = {values[0], values[1], values[2]};
+  } else {
+    geo_.eval(t, val);
+    out.point = {val[0], val[1], val[2]};
+  }
   out.distance = std::sqrt(f);
-  if (values) std::copy(val, val + dim, values);
   return out;
 }
 
 bool SurfaceDistance::descend(const std::array<double, 3>& p, std::array<double, 2>& t, double& f, double* buf,
                               double* val) const {
-  const auto du = surface_.domain(0), dv = surface_.domain(1);
+  const auto du = geo_.domain(0), dv = geo_.domain(1);
   const double lo[2] = {du[0], dv[0]}, hi[2] = {du[1], dv[1]};
-  const int dim = surface_.dim();
+  constexpr int dim = 3;
   const auto f_at = [&](const std::array<double, 2>& x) {
-    surface_.eval(x, val);
+    geo_.eval(x, val);
     const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
     return dot3(r, r);
   };
   for (int it = 0; it < 40; ++it) {
-    surface_.eval_derivatives(t, 2, buf);
+    geo_.eval_derivatives(t, 2, buf);
     const double* S = buf;
     const double* Su = S + dim;
     const double* Sv = S + 2 * dim;

@@ -478,8 +478,12 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
       auto enc = fillet::encode_shepard(fillets[k].halves[h], field, {.power = op.shepard_power});
       rep.shepard.push_back({enc.max_error, enc.rms_error, enc.check_error, enc.samples, enc.seconds});
       cells.emplace_back(base + (h == 0 ? "a" : "b"), std::move(enc.half));
-      cells.back().shepard = sd;
     }
+    // The sources as the encoded halves' faces w = 0 (the same surfaces, refined across C): the
+    // encoded properties there are then the sources' g_i, control point for control point.
+    for (std::size_t h = 0; h < 2; ++h)
+      sd.sources[h] = spline::boundary_face(cells[cells.size() - 2 + h].volume, spline::Face::w0);
+    for (std::size_t h = 0; h < 2; ++h) cells[cells.size() - 2 + h].shepard = sd;
   }
   out.fillets.push_back(std::move(rep));
   return cells;

@@ -166,7 +166,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const slice::MaterialMapper mapper(palette, model.properties);
   const slice::DitherMode mode = slice::parse_dither_mode(opt.dither);
 
-  const slice::LayerSampler sampler(model, grid);
+  const slice::LayerSampler sampler(model, grid, opt.sampler);
   const int nx = grid.count[0], ny = grid.count[1], nz = grid.count[2];
   const int nmat = mapper.materials();
   const int nprops = static_cast<int>(model.properties.size());

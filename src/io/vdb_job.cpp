@@ -346,7 +346,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   fine.origin = plan.origin;
   fine.pitch = {vx / N, vx / N, vx / N};
   fine.count = {nx * N, ny_pad * N, nz * N};
-  const slice::LayerSampler sampler(model, fine);
+  const slice::LayerSampler sampler(model, fine, opt.sampler);
   const int nyf = fine.count[1];
 
   // Tasks: 8 layers (one leaf) in z by `band` rows (whole leaves) in y, every column.

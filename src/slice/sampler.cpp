@@ -684,11 +684,86 @@ private:
 
 }  // namespace
 
+const char* property_blend_name(PropertyBlend b) noexcept { return b == PropertyBlend::shepard ? "shepard" : "encoded"; }
+
+bool property_blend_from_name(std::string_view name, PropertyBlend& out) noexcept {
+  if (name == "encoded") out = PropertyBlend::encoded;
+  else if (name == "shepard") out = PropertyBlend::shepard;
+  else return false;
+  return true;
+}
+
 LayerSampler::LayerSampler(const vmodel::VModel& model, const VoxelGrid& grid, SamplerOptions opt)
     : grid_(grid), opt_(opt), locator_(model, options_for(grid)) {
   if (grid.count[0] < 1 || grid.count[1] < 1 || grid.count[2] < 1)
     throw Error("voxel grid of " + std::to_string(grid.count[0]) + " x " + std::to_string(grid.count[1]) + " x " +
                 std::to_string(grid.count[2]) + " voxels; expected at least one along each axis");
+  if (opt_.blend != PropertyBlend::shepard || model.properties.empty()) return;
+  shepard_of_.assign(model.cells.size(), -1);
+  std::vector<const vmodel::ShepardData*> data;
+  for (std::size_t c = 0; c < model.cells.size(); ++c) {
+    const auto& sd = model.cells[c].shepard;
+    if (!sd) continue;
+    std::size_t k = 0;
+    while (k < data.size() && !(*data[k] == *sd)) ++k;
+    if (k == data.size()) {
+      data.push_back(&*sd);
+      try {
+        shepard_.push_back(std::make_unique<fillet::ShepardField>(*sd));
+      } catch (const Error& e) {
+        throw e.within("cell " + model.cells[c].name);
+      }
+    }
+    shepard_of_[c] = static_cast<int>(k);
+  }
+  if (shepard_.empty()) shepard_of_.clear();
+}
+
+void LayerSampler::apply_shepard(int layer, int r0, int nr, std::int32_t* owner, float* props) const {
+  const int nx = grid_.count[0], ny = grid_.count[1];
+  const auto m = static_cast<std::size_t>(locator_.model().properties.size());
+  // Per field a few walks, each the state at its last point: a voxel starts from the walk whose
+  // last point is nearest (the previous voxel of the row, or the voxel above it in the previous
+  // row, or the other side of a gap), a new walk (cold) when none is within `reach`. All state
+  // is local to the block, so a voxel's value depends only on its block.
+  constexpr std::size_t slots = 4;
+  const double reach = 8.0 * std::max({grid_.pitch[0], grid_.pitch[1], grid_.pitch[2]});
+  std::vector<std::array<fillet::ShepardWalk, slots>> walks(shepard_.size());
+  std::vector<std::array<std::int64_t, slots>> used(shepard_.size(), std::array<std::int64_t, slots>{});
+  std::vector<double> f(m);
+  std::int64_t voxels = 0, warm = 0;
+  for (int r = 0; r < nr; ++r) {
+    const int j = ny - 1 - (r0 + r);  // image row -> grid row (grid.hpp)
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t v = static_cast<std::size_t>(r) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(i);
+      const int c = owner[v];
+      if (c < 0) continue;
+      const int k = shepard_of_[static_cast<std::size_t>(c)];
+      if (k < 0) continue;
+      const auto p = grid_.centre(i, j, layer);
+      auto& ws = walks[static_cast<std::size_t>(k)];
+      auto& age = used[static_cast<std::size_t>(k)];
+      std::size_t best = slots, oldest = 0;
+      double bd = reach;
+      for (std::size_t s = 0; s < slots; ++s) {
+        if (age[s] < age[oldest]) oldest = s;
+        if (!ws[s].valid) continue;
+        const double d = std::hypot(p[0] - ws[s].p[0], p[1] - ws[s].p[1], p[2] - ws[s].p[2]);
+        if (d < bd) bd = d, best = s;
+      }
+      if (best == slots) {  // cold, in the least recently used slot
+        best = oldest;
+        ws[best].valid = false;
+      }
+      age[best] = ++voxels;
+      shepard_[static_cast<std::size_t>(k)]->eval(p, f.data(), &ws[best]);
+      std::transform(f.begin(), f.end(), props + v * m, [](double x) { return static_cast<float>(x); });
+    }
+  }
+  for (const auto& ws : walks)
+    for (const auto& w : ws) warm += w.warm;
+  shepard_voxels_ += voxels;
+  shepard_warm_ += warm;
 }
 
 void LayerSampler::sample(int layer, int row0, int rows, RowBand& out) const {
@@ -737,6 +812,7 @@ void LayerSampler::sample(int layer, int row0, int rows, RowBand& out) const {
       blk.uvw = opt_.keep_uvw ? uvw.data() : nullptr;
     }
     bs.run(layer, r0, nr, blk);
+    if (!shepard_.empty()) apply_shepard(layer, r0, nr, blk.owner, blk.props);
     for (int r = from; r < to; ++r) {
       const auto src = static_cast<std::size_t>(r - r0), dst = static_cast<std::size_t>(r - row0);
       if (!direct) {

@@ -161,8 +161,12 @@ TEST_CASE("scene: fillet parameters are checked where they are written", "[scene
                 {"/operations/0/section: unknown section \"round\"; expected \"hermite\" or \"flend\""});
   check_message(build_error(op(between + R"("distance": 1, "method": "exact")")),
                 {"/operations/0/method: unknown method \"exact\"; expected \"auto\", \"compose\" or \"fit\""});
-  check_message(build_error(op(between + R"("distance": 1, "blend": "shepard")")),
-                {"/operations/0/blend: \"shepard\" is not supported yet"});
+  check_message(build_error(op(between + R"("distance": 1, "blend": "idw")")),
+                {"/operations/0/blend: unknown blend \"idw\"; expected \"parametric\" or \"shepard\""});
+  check_message(build_error(op(between + R"("distance": 1, "blend": "shepard", "power": 1.5)")),
+                {"/operations/0/power: found", "expected a power q, an integer in 1..16"});
+  check_message(build_error(op(between + R"("distance": 1, "power": 2)")),
+                {"/operations/0/power: a power without \"blend\": \"shepard\""});
   check_message(build_error(op(between + R"("distance": 1, "flip": "yes")")),
                 {"/operations/0/flip: found", "expected true, false or [bool, bool]"});
   check_message(build_error(op(R"("between": ["ball.x9", "box"], "distance": 1)")),

@@ -22,8 +22,9 @@
 /// of T, and solving a least-square-fitting problem ... fix ... the points at the boundaries"):
 /// the half's properties become G + R, G(u, v) its own properties on the face w = 0 (S^_i with
 /// g_i, copied along w) and R a tensor-product spline in a fit space (the half's u and v spaces,
-/// or for many control points order 4 on at most `max_spans` of its breakpoints, and order 4 with
-/// `w_spans` uniform spans along w) whose control points at w = 0 are pinned to zero, fitted by
+/// or for many control points order 4 on at most `max_spans` of its breakpoints; v with knots
+/// graded towards both ends, one of them C, where f turns fastest; along w order 4 with `w_spans`
+/// spans graded towards w = 0) whose control points at w = 0 are pinned to zero, fitted by
 /// least squares to f - G at Gauss points of every span (a full tensor grid, so the least
 /// squares solution is the Kronecker product of the three 1-D pseudo-inverses). Half and R are
 /// then brought into one space (spline::make_compatible); the control points of the face w = 0
@@ -40,7 +41,8 @@
 ///
 /// Cost: f at one point: two closest-point queries (warm: two or three Newton steps, each one
 /// evaluation with second partials of S^_i) and two evaluations. Encoding: one f per sample,
-/// (spans_u * (o_u + 1)) x (spans_v * (o_v + 1)) x (w_spans * 5) samples, in parallel.
+/// about (2 n_u) x (2 n_v) x (2 n_w) samples for a fit space of n_u x n_v x n_w, and as many
+/// again at midpoints for the check, in parallel.
 #pragma once
 #include <array>
 #include <cstdint>
@@ -97,7 +99,8 @@ private:
 
 struct ShepardOptions {
   int power = 2;       ///< q, 1..16
-  int w_spans = 3;     ///< uniform spans of the fit space along w (1..16)
+  int w_spans = 4;     ///< spans of the fit space along w, graded towards w = 0: 2^-k (1..16)
+  int grade = 2;       ///< v: knots 1/2, 2^-k and 1 - 2^-k for k = 2..grade + 1 added (0: none)
   int w_order = 4;     ///< order of the fit space along w (2..8)
   int max_spans = 64;  ///< u or v: at most this many spans of the half's breakpoints in the fit
   int max_direct = 24; ///< u or v with at most this many control points: the half's own space

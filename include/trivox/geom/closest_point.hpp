@@ -61,9 +61,11 @@ public:
 
 private:
   /// Newton from t (with |S(t) - p|^2 = f) to a stationary point; returns converged.
+  /// buf: 18 values, val: 3.
   bool descend(const std::array<double, 3>& p, std::array<double, 2>& t, double& f, double* buf, double* val) const;
 
   spline::Surface surface_;
+  spline::Surface geo_;                     ///< its xyz alone (what Newton evaluates)
   std::vector<std::array<double, 2>> uv_;   ///< sample parameters
   std::vector<std::array<double, 3>> xyz_;  ///< sample points
 };

@@ -26,6 +26,7 @@
 
 #include "trivox/io/manifest.hpp"
 #include "trivox/slice/grid.hpp"
+#include "trivox/slice/sampler.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
 namespace trivox::io {
@@ -40,6 +41,7 @@ struct SliceJobOptions {
   bool zip = false;                            ///< also pack the folder as <out_dir>.gcvf
   std::int64_t max_voxels = 100'000'000'000;   ///< refuse larger grids unless force
   int band_rows = 64;                          ///< rows sampled and dithered at a time
+  slice::SamplerOptions sampler;               ///< sampling options (the Shepard blend, --blend)
 
   // The manifest (manifest.hpp): what identifies the job, resuming, sharding.
   std::string model_file;                      ///< the model file's name, as given

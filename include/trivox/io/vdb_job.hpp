@@ -43,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "trivox/slice/sampler.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
 namespace trivox::io {
@@ -64,6 +65,7 @@ struct VdbJobOptions {
   /// give the whole job's. Empty: every layer.
   std::optional<std::array<int, 2>> layer_range;
   std::string file_name;              ///< the file's name in out_dir; empty: <model stem>.vdb
+  slice::SamplerOptions sampler;      ///< sampling options (the Shepard blend, --blend)
 };
 
 /// The grid a VDB job will use, found before anything is written.

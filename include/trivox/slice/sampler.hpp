@@ -42,6 +42,10 @@
 /// through slice/trim.hpp's apply_trimming, so occupancy and properties follow the trimming
 /// exactly (one point location per condition for each voxel of a trimmed cell).
 ///
+/// Shepard fillets (SamplerOptions::blend = shepard): after a block is sampled, every voxel held
+/// by a cell with Shepard data gets f at its centre (fillet/shepard.hpp), the walk of warm starts
+/// running along each row of the block; cells without it are untouched.
+///
 /// Determinism: a block's result depends only on the block (layer and its 4 image rows); a band
 /// computes every block it touches in full and copies out its rows, so any banding and thread
 /// count give identical output.
@@ -51,8 +55,13 @@
 /// iterations per voxel near boundaries; per row a pass over the leaves that meet the block;
 /// void voxels outside every leaf region cost nothing. No allocation per voxel.
 #pragma once
+#include <atomic>
 #include <cstdint>
+#include <memory>
+#include <string_view>
 #include <vector>
+
+#include "trivox/fillet/shepard.hpp"
 
 #include "trivox/slice/grid.hpp"
 #include "trivox/slice/locator.hpp"
@@ -87,9 +96,24 @@ struct RowBand {
   }
 };
 
-/// Sampling options (room for per-voxel blending, --blend, later).
+/// Which properties the fillet cells that carry Shepard data (vmodel::ShepardData) get.
+enum class PropertyBlend : std::uint8_t {
+  encoded,  ///< their control points' (the least-squares encoding of f): the default
+  /// f itself, exactly per voxel (seed 000 Sec. 7.2; fillet/shepard.hpp): two closest-point
+  /// queries per voxel of those cells, warm-started along each image row of a block (cold at
+  /// every row's first such voxel), so a voxel's value depends only on its block.
+  shepard,
+};
+
+/// "encoded", "shepard".
+const char* property_blend_name(PropertyBlend b) noexcept;
+/// The blend called `name`, or false.
+bool property_blend_from_name(std::string_view name, PropertyBlend& out) noexcept;
+
+/// Sampling options.
 struct SamplerOptions {
   bool keep_uvw = false;  ///< also fill RowBand::uvw (tests, diagnostics)
+  PropertyBlend blend = PropertyBlend::encoded;  ///< properties of Shepard fillet cells
 };
 
 class LayerSampler {
@@ -117,10 +141,23 @@ public:
   const VoxelGrid& grid() const noexcept { return grid_; }
   const Locator& locator() const noexcept { return locator_; }
 
+  /// Voxels whose properties were the exact Shepard blend, and how many of their closest-point
+  /// queries were warm (cost figures, summed over every sample() call; thread-safe counters).
+  std::int64_t shepard_voxels() const noexcept { return shepard_voxels_.load(); }
+  std::int64_t shepard_warm() const noexcept { return shepard_warm_.load(); }
+
 private:
+  /// PropertyBlend::shepard: f at every voxel of block rows [r0, r0 + nr) held by a Shepard cell.
+  void apply_shepard(int layer, int r0, int nr, std::int32_t* owner, float* props) const;
+
   VoxelGrid grid_;
   SamplerOptions opt_;
   Locator locator_;
+  /// Per cell: index into shepard_ (-1: no Shepard data or the encoded blend); cells with equal
+  /// data (the two halves of a fillet) share one field.
+  std::vector<int> shepard_of_;
+  std::vector<std::unique_ptr<fillet::ShepardField>> shepard_;
+  mutable std::atomic<std::int64_t> shepard_voxels_{0}, shepard_warm_{0};
 };
 
 }  // namespace trivox::slice
