@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "corner.hpp"
 #include "trivox/construct/constructors.hpp"
 #include "trivox/fillet/blend_surface.hpp"
 #include "trivox/fillet/compose.hpp"
@@ -20,6 +21,7 @@ using spline::Curve;
 using spline::KnotVector;
 using spline::Surface;
 using Vec = std::array<double, 3>;
+using fillet_test::Corner;
 
 namespace {
 
@@ -38,20 +40,6 @@ Curve random_param_curve(std::mt19937& rng, double lo, double hi) {
   return Curve({KnotVector(4, {0, 0, 0, 0, 1.0 / 3, 2.0 / 3, 1, 1, 1, 1})}, 2, pts);
 }
 
-/// A bilinear patch through four corners (u fastest), in R^dim.
-Surface patch(const std::vector<double>& c00, const std::vector<double>& c10, const std::vector<double>& c01,
-              const std::vector<double>& c11) {
-  std::vector<double> pts;
-  for (const auto* c : {&c00, &c10, &c01, &c11}) pts.insert(pts.end(), c->begin(), c->end());
-  return Surface({KnotVector::bezier(2), KnotVector::bezier(2)}, static_cast<int>(c00.size()), pts);
-}
-
-Curve line(double u0, double v0, double u1, double v1) {
-  // Cubic, so it is in the same space as the rails of real fillets.
-  Curve c({KnotVector::bezier(2)}, 2, {u0, v0, u1, v1});
-  return spline::elevate(c, 0, 2);
-}
-
 Vec at(const Surface& s, double u, double v) {
   const auto p = s.eval({u, v});
   return {p[0], p[1], p[2]};
@@ -65,31 +53,6 @@ double angle_between_normals(const Surface& a, double ua, double va, const Vec& 
   const double c = std::abs(m[0] * n[0] + m[1] * n[1] + m[2] * n[2]) / std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
   return std::acos(std::min(1.0, c));
 }
-
-/// The right-angled corner: floor z = 0 (x in [2, 6], y in [0, 4]) outside a wall x <= 2 whose
-/// face x = 2 spans z in [0, 4]. C is the line x = 2, z = 0, y = 4t; rail 1 at x = 2 + d1 on the
-/// floor, rail 2 at z = d2 on the wall. Properties: one per point, linear on each face.
-struct Corner {
-  double d1 = 1.0, d2 = 0.5;
-  // Floor (u, v) -> (2 + 4u, 4v, 0), property 10 + u; wall (u, v) -> (2, 4u, 4v), property 20 + v.
-  Surface floor_ = patch({2, 0, 0, 10}, {6, 0, 0, 11}, {2, 4, 0, 10}, {6, 4, 0, 11});
-  Surface wall = patch({2, 0, 0, 20}, {2, 4, 0, 20}, {2, 0, 4, 21}, {2, 4, 4, 21});
-  // In parameters: C on the floor is u = 0, v = t; rail 1 is u = d1 / 4. On the wall C is v = 0,
-  // u = t; rail 2 is v = d2 / 4.
-  Curve base1 = line(0, 0, 0, 1), rail1 = line(d1 / 4, 0, d1 / 4, 1);
-  Curve base2 = line(0, 0, 1, 0), rail2 = line(0, d2 / 4, 1, d2 / 4);
-
-  Surface sub1() const { return fillet::subregion(floor_, rail1, base1); }
-  Surface sub2() const { return fillet::subregion(wall, base2, rail2); }
-  fillet::BlendInput input(const Surface& s1, const Surface& s2) const {
-    fillet::BlendInput in;
-    in.faces = {&floor_, &wall};
-    in.rail_uv = {rail1, rail2};
-    in.rail = {spline::iso(s1, 1, 0.0), spline::iso(s2, 1, 1.0)};
-    in.center = spline::iso(s1, 1, 1.0);
-    return in;
-  }
-};
 
 }  // namespace
 
