@@ -54,7 +54,7 @@
 ///
 /// Cost: one common-space refinement of three surfaces and one of nine sleeve surfaces across
 /// (the direction along C is never converted), then linear in the control points of the result:
-/// 1207 x 5 x 5 per cell for a cylinder on a floor in about 0.1 s.
+/// 1207 x 5 x 5 per cell for a cylinder on a floor in 0.06 s (the ruled fillet: 0.06 s).
 #pragma once
 #include <array>
 
