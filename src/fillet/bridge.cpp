@@ -195,12 +195,7 @@ Trivariate bridge(const Trivariate& cell1, spline::Face fa, const Trivariate& ce
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j)
         for (int l = 0; l < n; ++l) {
-          const auto d = t.eval_derivatives({(i + 0.5) / n, (j + 0.5) / n, (l + 0.5) / n}, 1);
-          const std::size_t kk = static_cast<std::size_t>(k);
-          const Vec du{d[kk], d[kk + 1], d[kk + 2]}, dv{d[2 * kk], d[2 * kk + 1], d[2 * kk + 2]},
-              dw{d[3 * kk], d[3 * kk + 1], d[3 * kk + 2]};
-          const double det = du[0] * (dv[1] * dw[2] - dv[2] * dw[1]) - du[1] * (dv[0] * dw[2] - dv[2] * dw[0]) +
-                             du[2] * (dv[0] * dw[1] - dv[1] * dw[0]);
+          const double det = jacobian_at(t, {(i + 0.5) / n, (j + 0.5) / n, (l + 0.5) / n});
           q.det_min = std::min(q.det_min, det);
           q.det_max = std::max(q.det_max, det);
         }

@@ -108,9 +108,7 @@ void measure(const std::array<const Surface*, 2>& faces, const std::array<Curve,
     for (int a = 0; a < n0; ++a)
       for (int b = 0; b < n1; ++b)
         for (int c = 0; c < n2; ++c) {
-          const auto d = h.eval_derivatives({(a + 0.5) / n0, (b + 0.5) / n1, (c + 0.5) / n2}, 1);
-          const std::size_t kk = static_cast<std::size_t>(h.dim());
-          const double det = dot({d[kk], d[kk + 1], d[kk + 2]}, cross(xyz(d.data() + 2 * kk), xyz(d.data() + 3 * kk)));
+          const double det = jacobian_at(h, {(a + 0.5) / n0, (b + 0.5) / n1, (c + 0.5) / n2});
           q.det_min = std::min(q.det_min, det);
           q.det_max = std::max(q.det_max, det);
         }

@@ -1,5 +1,5 @@
 // Internal to the fillet module: small vector arithmetic in R^3, number formatting for messages,
-// and the knot halving the adaptive fits share.
+// the knot halving the adaptive fits share, and det J at a point.
 #pragma once
 #include <algorithm>
 #include <array>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "trivox/spline/knot_vector.hpp"
+#include "trivox/spline/tensor_spline.hpp"
 
 namespace trivox::fillet::detail {
 
@@ -40,6 +41,13 @@ inline spline::KnotVector halved(const spline::KnotVector& k) {
   for (std::size_t i = 0; i + 1 < br.size(); ++i) all.push_back(0.5 * (br[i].value + br[i + 1].value));
   std::sort(all.begin(), all.end());
   return spline::KnotVector(k.order(), all);
+}
+
+/// det[dX/du, dX/dv, dX/dw] of a trivariate's xyz at t.
+inline double jacobian_at(const spline::Trivariate& s, const std::array<double, 3>& t) {
+  const auto d = s.eval_derivatives(t, 1);
+  const std::size_t k = static_cast<std::size_t>(s.dim());
+  return dot(xyz(d.data() + k), cross(xyz(d.data() + 2 * k), xyz(d.data() + 3 * k)));
 }
 
 }  // namespace trivox::fillet::detail

@@ -8,6 +8,7 @@
 
 #include "property_blend.hpp"
 #include "trivox/construct/constructors.hpp"
+#include "fillet_util.hpp"
 #include "trivox/error.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/spline/refine.hpp"
@@ -18,14 +19,9 @@ using spline::Curve;
 using spline::KnotVector;
 using spline::Surface;
 using spline::Trivariate;
+using detail::num;
 
 namespace {
-
-std::string num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
 
 /// Row j across (direction 1) of s: the curve along u whose control points are s's P_{m, j}.
 Curve row(const Surface& s, int j) {
@@ -139,14 +135,6 @@ void merge_close_knots(std::vector<Surface>& pieces) {
   }
 }
 
-double det_at_centre(const Trivariate& t) {
-  const auto d = t.eval_derivatives({0.5, 0.5, 0.5}, 1);
-  const std::size_t k = static_cast<std::size_t>(t.dim());
-  const double* a = d.data() + k;
-  const double* b = d.data() + 2 * k;
-  const double* c = d.data() + 3 * k;
-  return a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-}
 
 /// Writes face f's control net into the boundary layer of t where direction dir has index
 /// `index` (f's parameters are t's two other directions in increasing order, in t's spaces).
@@ -329,7 +317,8 @@ std::array<Trivariate, 3> vbs_fillet(const Surface& sub1, const Surface& sub2, c
   std::array<Trivariate, 3> cells{cell(f[S1B], f[D2], f[D1], f[S2A]),   // T_1 at C
                                   cell(f[S1A], f[DB], f[BA], f[D1]),    // T_2 at rail 1
                                   cell(f[DB], f[S2B], f[BB], f[D2])};   // T_3 at rail 2
-  const double d[3] = {det_at_centre(cells[0]), det_at_centre(cells[1]), det_at_centre(cells[2])};
+  const double d[3] = {detail::jacobian_at(cells[0], {0.5, 0.5, 0.5}), detail::jacobian_at(cells[1], {0.5, 0.5, 0.5}),
+                       detail::jacobian_at(cells[2], {0.5, 0.5, 0.5})};
   if (!((d[0] > 0 && d[1] > 0 && d[2] > 0) || (d[0] < 0 && d[1] < 0 && d[2] < 0)))
     throw Error("VBS fillet: det J at the cells' centres is " + num(d[0]) + ", " + num(d[1]) + " and " + num(d[2]) +
                     "; expected one sign (the division of the cross-section folds)",
