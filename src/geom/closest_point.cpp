@@ -123,6 +123,7 @@ bool SurfaceDistance::descend(const std::array<double, 3>& p, std::array<double,
     const double r[3] = {val[0] - p[0], val[1] - p[1], val[2] - p[2]};
     return dot3(r, r);
   };
+  double last = std::numeric_limits<double>::infinity();  // the previous step's size
   for (int it = 0; it < 40; ++it) {
     geo_.eval_derivatives(t, 2, buf);
     const double* S = buf;
@@ -172,9 +173,10 @@ bool SurfaceDistance::descend(const std::array<double, 3>& p, std::array<double,
     if (!(fn <= f) && !small) return true;  // no descent: t is stationary to working precision
     t = next;
     f = fn;
-    // Converged: a step of 1e-12 of the domain is at the rounding floor of the gradient of an
-    // order-19 patch (steps of 1e-14 then wander without settling).
-    if (moved < 1e-12) return true;
+    // Converged: a step below 1e-15 of the domain; or below 1e-12 without shrinking any more,
+    // the rounding floor of the gradient (on order-19 patches steps of 1e-14 wander).
+    if (moved < 1e-15 || (moved < 1e-12 && moved > 0.25 * last)) return true;
+    last = moved;
   }
   return false;
 }

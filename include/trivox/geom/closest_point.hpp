@@ -35,7 +35,8 @@ struct ClosestPoint {
   std::array<double, 2> uv{};      ///< parameters of the closest point
   std::array<double, 3> point{};   ///< S(uv), xyz
   double distance = 0.0;           ///< |S(uv) - P|
-  /// Newton ended at a stationary point (step below 1e-12 of the domain, or no descent left);
+  /// Newton ended at a stationary point (step below 1e-15 of the domain, below 1e-12
+  /// and no longer shrinking, or no descent left);
   /// false when it ran out of iterations.
   bool converged = true;
 };
