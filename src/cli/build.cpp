@@ -38,6 +38,19 @@ struct CellQuality {
   double volume = 0.0;
 };
 
+/// A Shepard fillet's encoding fit (fillet/shepard.hpp) for component k: its two cells, a then b;
+/// null for parametric fillets.
+nlohmann::ordered_json shepard_fit(const io::FilletBuild& f, std::size_t k) {
+  if (f.shepard.size() < 2 * (k + 1)) return nullptr;
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (std::size_t h = 0; h < 2; ++h) {
+    const auto& s = f.shepard[2 * k + h];
+    out.push_back({{"max_error", s.max_error}, {"rms_error", s.rms_error}, {"check_error", s.check_error},
+                   {"samples", s.samples}, {"seconds", s.seconds}});
+  }
+  return out;
+}
+
 nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<CellQuality>& q, const Options& opt) {
   const auto& cells = built.model.cells;
   std::vector<std::string> source(cells.size());
@@ -118,7 +131,8 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                     {"sub2", shape(q2.sub[1])},
                     {"blend", shape(q2.blend)},
                     {"fillet", shape(q2.fillet)},
-                    {"seconds", q2.seconds}});
+                    {"seconds", q2.seconds},
+                    {"shepard", shepard_fit(f, k)}});
     }
   nlohmann::ordered_json jb = nlohmann::ordered_json::array();
   for (const auto& b : built.bridges)
