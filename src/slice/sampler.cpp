@@ -729,7 +729,7 @@ void LayerSampler::apply_shepard(int layer, int r0, int nr, std::int32_t* owner,
   constexpr std::size_t slots = 4;
   const double reach = 8.0 * std::max({grid_.pitch[0], grid_.pitch[1], grid_.pitch[2]});
   std::vector<std::array<fillet::ShepardWalk, slots>> walks(shepard_.size());
-  std::vector<std::array<std::int64_t, slots>> used(shepard_.size(), std::array<std::int64_t, slots>{});
+  std::vector<std::int64_t> used(shepard_.size() * slots, 0);  // last use of each walk, per field
   std::vector<double> f(m);
   std::int64_t voxels = 0, warm = 0;
   for (int r = 0; r < nr; ++r) {
@@ -742,7 +742,7 @@ void LayerSampler::apply_shepard(int layer, int r0, int nr, std::int32_t* owner,
       if (k < 0) continue;
       const auto p = grid_.centre(i, j, layer);
       auto& ws = walks[static_cast<std::size_t>(k)];
-      auto& age = used[static_cast<std::size_t>(k)];
+      std::int64_t* age = used.data() + static_cast<std::size_t>(k) * slots;
       std::size_t best = slots, oldest = 0;
       double bd = reach;
       for (std::size_t s = 0; s < slots; ++s) {
