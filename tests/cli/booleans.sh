@@ -7,11 +7,7 @@
 # 16 V-points) and a voxel count equal to its 3 unit-cube volume; where two inputs overlap a
 # sum_clip blend gives the sum of their values; bad operands exit 2 naming the place.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
+source tests/cli/lib.bash "$@"
 
 cat > "$tmp/half.json" <<'EOF'
 { "trivox": 1, "units": "mm", "properties": ["r"],

@@ -6,11 +6,7 @@
 # Fig. 9; see tests/construct/test_primitives.cpp); a coarse slice's voxel count times the voxel
 # volume is the total volume up to the voxelisation of the surface (3 percent at 35 dpi).
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
+source tests/cli/lib.bash "$@"
 
 "$trivox" build models/primitives.json -o "$tmp/m.json" --json > "$tmp/build.json"
 "$trivox" info "$tmp/m.json" --json > "$tmp/info.json"

@@ -8,11 +8,7 @@
 # (Python evaluates the written surface independently with Cox-de Boor); the volumetric
 # Boolean sum of a box's six faces has volume 6 = 1 x 2 x 3; bad inputs exit 2 naming the place.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
+source tests/cli/lib.bash "$@"
 
 "$py" - "$tmp" <<'PY'
 import sys, json

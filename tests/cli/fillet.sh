@@ -10,11 +10,7 @@
 # Bad fillets exit 2 naming the operation and what is wrong; a fillet whose det J changes sign
 # exits 1 and is not written. A bridge between disjoint boxes has the analytic volume.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
+source tests/cli/lib.bash "$@"
 
 corner() {  # corner FILLET-FIELDS: floor [0,4]x[0,4]x[-1,0] red, wall [1,2]x[-0.5,4.5]x[-0.5,3] blue
   cat > "$tmp/corner.json" <<EOF

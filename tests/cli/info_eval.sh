@@ -5,10 +5,7 @@
 # (a translational sweep along z: volume 40 * 10 * 4 = 1600); its cells are linear or quadratic,
 # so eval's values follow from the control points by hand.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source tests/cli/lib.bash "$@"
 
 "$trivox" --version | grep -Eq '^trivox [0-9]+\.[0-9]+\.[0-9]+$'
 
@@ -48,7 +45,6 @@ PY
 "$trivox" eval models/gismo/cube.xml --cell patch0 --uvw 0.5,0.5,0.5 | grep -q "point: (0.5, 0.5, 0.5)"
 
 # Bad input: exit 2 and a message naming the file, the place and what was expected.
-source "$(dirname "$0")/lib.bash"
 expect_fail "no-such.json" "$trivox" info no-such.json
 expect_fail "expected" "$trivox" info models
 printf '{"trivox": 1, "cells": [' > "$tmp/trunc.json"

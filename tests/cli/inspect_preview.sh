@@ -4,10 +4,7 @@
 # Truths: voxel counts are numpy's count of the pixels written; the voxel volume is
 # 25.4/600 * 25.4/300 * 0.027 mm^3; the preview is read back with OpenImageIO.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source tests/cli/lib.bash "$@"
 
 # A 40 x 24 px, 6-layer stack with three materials; prints the counts as JSON.
 "$py" - "$tmp/stack" > "$tmp/truth.json" <<'PY'
@@ -138,7 +135,6 @@ set -e
 [ $rc -eq 1 ] && grep -q "VoxelCount mismatch" "$tmp/err"
 
 # Bad input: exit 2, a message naming the file, the place and what was expected; no stdout.
-source "$(dirname "$0")/lib.bash"
 mkdir "$tmp/empty"
 expect_fail "no ConfigFile.xml; expected a slice folder" "$trivox" inspect "$tmp/empty"
 expect_fail "no such folder" "$trivox" inspect "$tmp/nothing"

@@ -4,11 +4,8 @@
 # of one uninterrupted job (cmp, every file); the manifest's SHA-256s are those of the files
 # (Python's hashlib); broken or missing shards are named, with what to rerun.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
+source tests/cli/lib.bash "$@"
 trap 'kill %1 2>/dev/null || true; rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
 
 model=models/graded_block.json
 grid=(--dpi 100,100 --layer 0.5 --progress never)    # 158 x 79 pixels, 88 layers

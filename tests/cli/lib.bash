@@ -1,4 +1,10 @@
-# Shared by the end-to-end scripts (sourced; not a test itself). Needs $tmp.
+# Shared by the end-to-end scripts (sourced; not a test itself): `source tests/cli/lib.bash "$@"`
+# right after `set -euo pipefail` sets $trivox (the binary under test, the script's first
+# argument), $py (the system Python, with numpy) and $tmp (a folder removed on exit).
+trivox=$1
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
 
 # expect_fail PATTERN command...: the command exits 2, says PATTERN on stderr, prints nothing on
 # stdout.

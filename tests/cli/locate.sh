@@ -4,10 +4,7 @@
 # y, z), so (10, 10, 5) lies in it at (0.25, 0.5, 0.5); the Fichera corner is [-1,1]^3 without
 # the octant x, y < 0 < z; a point's properties equal `trivox eval` at the located (u,v,w).
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source tests/cli/lib.bash "$@"
 
 "$trivox" locate models/graded_block.json --xyz 10,10,5 --json > "$tmp/in.json"
 "$py" - "$tmp/in.json" <<'PY'
@@ -65,7 +62,6 @@ PY
 "$trivox" locate models/graded_block.json --xyz 100,10,5 | grep -q "outside every cell"
 
 # Bad input: exit 2 and a message naming what was expected; nothing on stdout.
-source "$(dirname "$0")/lib.bash"
 expect_fail "expected 3 comma-separated numbers" "$trivox" locate models/graded_block.json --xyz 1,2
 expect_fail "not a finite number" "$trivox" locate models/graded_block.json --xyz 1,inf,2
 expect_fail "not a finite number" "$trivox" locate models/graded_block.json --xyz 1,x,2

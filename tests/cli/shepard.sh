@@ -9,11 +9,7 @@
 # --blend shepard` writes the same bytes with 1 and 2 threads, and differs from the encoded
 # slice only where the fit's error changes a voxel. Bad powers and blends exit 2.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
+source tests/cli/lib.bash "$@"
 
 scene() {  # scene EXTRA-FIELDS
   cat > "$tmp/corner.json" <<EOF

@@ -5,10 +5,7 @@
 # layers) has 8 voxel centres per axis at -1 + (i + 1/2) 0.254, none on a face: 8^3 - 4^3 = 448
 # voxels inside.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+source tests/cli/lib.bash "$@"
 
 "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --threads 1 --progress never --json > "$tmp/f1.json"
 "$trivox" slice models/gismo/fichera.xml -o "$tmp/f2" --dpi 100,100 --layer 0.254 --threads 2 --progress never > /dev/null
@@ -58,7 +55,6 @@ assert summary["filled"] == 448 and summary["inversion_failures"] == 0, summary
 PY
 
 # Refusals: exit 2 with the reason.
-source "$(dirname "$0")/lib.bash"
 expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never
 expect_fail "unknown printer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --printer j9000
 expect_fail "expected 10 to 10000" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x2" --dpi 0,100

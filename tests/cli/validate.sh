@@ -4,11 +4,7 @@
 # with one corner pulled through the opposite one folds, and Python evaluates det J at the
 # reported point independently (trilinear partials) to check its sign.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source tests/cli/lib.bash
+source tests/cli/lib.bash "$@"
 
 "$trivox" validate models/twisted_column.json > "$tmp/col.txt"
 grep -q "every cell is valid" "$tmp/col.txt"

@@ -12,11 +12,7 @@
 #   the subtractive conversion of materials.md (C = m - r, ..., K = 1 - m, W = r + g + b - 2m).
 # - A box with linear properties: property grids equal the linear function at voxel centres.
 set -euo pipefail
-trivox=$1
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-source "$(dirname "$0")/lib.bash"
+source "$(dirname "$0")/lib.bash" "$@"
 q="--progress never"
 
 # --- Fichera corner: exact occupancy, metadata, determinism across thread counts -------------
