@@ -138,6 +138,9 @@ Map1D elevate_map(const KnotVector& kv, int by) {
   auto br = c.to.breakpoints();
   for (auto& b : br) b.multiplicity += by;
   const KnotVector to = KnotVector::from_breakpoints(kv.order() + by, br);
+  // A clamped vector's clamp map is the identity: skip the dense product (cubic in the size,
+  // minutes for the thousand-span curves of fillets).
+  if (kv.clamped()) return {to, detail::transfer_matrix(c.to, to)};
   return {to, detail::transfer_matrix(c.to, to) * c.T};
 }
 
@@ -337,6 +340,7 @@ template <int P>
 TensorSpline<P> to_space(const TensorSpline<P>& s, int dir, const KnotVector& target) {
   check_dir(s, dir);
   if (s.knots(dir) == target) return s;
+  if (s.knots(dir).clamped()) return apply_map(s, dir, Map1D{target, detail::transfer_matrix(s.knots(dir), target)});
   const Map1D c = clamp_map(s.knots(dir));
   return apply_map(s, dir, Map1D{target, detail::transfer_matrix(c.to, target) * c.T});
 }

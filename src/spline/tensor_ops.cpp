@@ -55,13 +55,23 @@ Net<P> apply_along(const Net<P>& net, int d, const Eigen::MatrixXd& T) {
   out.H = net.H;
   const std::ptrdiff_t H = net.H;
   out.values.assign(static_cast<std::size_t>(outer * m * inner * H), 0.0);
+  // Transfer matrices are banded (refinement, elevation, restriction: a few non-zeros per row):
+  // each row's non-zero columns are found once, not once per line (that scan made applying a
+  // map to a surface with thousands of control points per direction quadratic per line).
+  std::vector<int> lo(static_cast<std::size_t>(m), n), hi(static_cast<std::size_t>(m), -1);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j)
+      if (T(j, i) != 0.0) {
+        lo[static_cast<std::size_t>(j)] = std::min(lo[static_cast<std::size_t>(j)], i);
+        hi[static_cast<std::size_t>(j)] = std::max(hi[static_cast<std::size_t>(j)], i);
+      }
   // Each (outer, inner) pair is one line: n entries with stride inner*H.
   for (std::ptrdiff_t o = 0; o < outer; ++o) {
     const double* src = net.values.data() + o * n * inner * H;
     double* dst = out.values.data() + o * m * inner * H;
     for (int j = 0; j < m; ++j) {
       double* drow = dst + j * inner * H;
-      for (int i = 0; i < n; ++i) {
+      for (int i = lo[static_cast<std::size_t>(j)]; i <= hi[static_cast<std::size_t>(j)]; ++i) {
         const double c = T(j, i);
         if (c == 0.0) continue;
         const double* srow = src + i * inner * H;
