@@ -2,7 +2,8 @@
 // into a model, writes it atomically (save_model: a temporary name, then a rename), and prints a
 // quality report: per cell the Jacobian validity bounds and the volume, per primitive the exact
 // volume against the cells' total and how closely the properties follow the field, per fillet
-// its gap, G1 angle, det J sign and property jump (fillet/fillet.hpp). Exit 1 when a cell is not
+// (ruled, seed 000 Alg. 2, VBS, Sec. 3.2 / Alg. 3, or V-rep, Sec. 5 / Alg. 6) its gap, C0 glue
+// between its cells, G1 angle, sampled det J sign and property jump (fillet/fillet.hpp). Exit 1 when a cell is not
 // valid (the model is written all the same, so it can be inspected).
 #include <tbb/parallel_for.h>
 
@@ -34,6 +35,7 @@ struct CellQuality {
   /// A fillet's half: det J vanishes on the faces that collapse onto the rails (seed 000 Sec. 9),
   /// so its verdict is the sign of det J inside, from the fillet's own report.
   const fillet::FilletQuality* fillet = nullptr;
+  std::size_t fillet_cell = 0;  ///< its index among the fillet's cells (FilletQuality::cell_jacobian)
   geom::ValidityReport<3> validity;
   double volume = 0.0;
 };
@@ -51,6 +53,34 @@ nlohmann::ordered_json shepard_fit(const io::FilletBuild& f, std::size_t k) {
   return out;
 }
 
+/// The scene's derived surfaces (G+Smo patches merged, offsets: construct/patches.hpp).
+nlohmann::ordered_json scene_surfaces(const io::SceneBuild& built) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const auto& s : built.surfaces) {
+    nlohmann::ordered_json o{{"name", s.name}, {"kind", s.kind}, {"orders", s.orders}, {"counts", s.counts}};
+    if (s.kind == "gismo") o["max_gap"] = s.max_gap;
+    if (s.kind == "offset")
+      o.update({{"distance", s.distance}, {"max_error", s.offset.max_error}, {"refinements", s.offset.refinements},
+                {"samples", s.offset.samples}});
+    o["seconds"] = s.seconds;
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+/// The constructor operations (seed 003 Sec. 3.2.2; construct/tube_solid.hpp for tubes).
+nlohmann::ordered_json constructs(const io::SceneBuild& built) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (const auto& c : built.constructs) {
+    nlohmann::ordered_json field = nullptr;
+    if (c.has_field)
+      field = {{"exact", c.field.exact}, {"max_error", c.field.max_error}, {"refinements", c.field.refinements},
+               {"converged", c.field.converged}};
+    out.push_back({{"name", c.name}, {"op", c.op}, {"cells", c.cells}, {"field", field}, {"seconds", c.seconds}});
+  }
+  return out;
+}
+
 nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<CellQuality>& q, const Options& opt) {
   const auto& cells = built.model.cells;
   std::vector<std::string> source(cells.size());
@@ -62,7 +92,8 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const auto& r = q[i].validity;
     if (const auto* f = q[i].fillet) {
-      const bool ok = f->jacobian() == "positive";
+      const auto& det = f->cell_jacobian.at(q[i].fillet_cell);
+      const bool ok = det[0] > 0.0;
       valid = valid && ok;
       total += q[i].volume;
       jc.push_back({{"name", cells[i].name},
@@ -71,8 +102,8 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                     {"counts", cells[i].volume.counts()},
                     {"valid", ok},
                     {"verdict", ok ? "fillet" : "invalid"},
-                    {"min_jacobian", f->det_min},
-                    {"max_jacobian", f->det_max},
+                    {"min_jacobian", det[0]},
+                    {"max_jacobian", det[1]},
                     {"volume", q[i].volume}});
       continue;
     }
@@ -114,16 +145,41 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
       const auto shape = [](const fillet::SplineShape& s) {
         return nlohmann::ordered_json{{"orders", s.orders}, {"counts", s.counts}};
       };
+      nlohmann::ordered_json vbs = nullptr;
+      if (q2.construction == fillet::Construction::vbs)
+        vbs = {{"v_b", q2.vbs.v_b},           {"v_1", q2.vbs.v_1},
+               {"v_2", q2.vbs.v_2},           {"c_gap", q2.vbs.c_gap},
+               {"rail_gap", q2.vbs.rail_gap}, {"c_property_jump", q2.vbs.property_jump},
+               {"reversed", q2.vbs.reversed}};
+      nlohmann::ordered_json vrep = nullptr;
+      if (q2.construction == fillet::Construction::vrep)
+        vrep = {{"v_b", q2.vrep.v_b},
+                {"c_gap", q2.vrep.c_gap},
+                {"rail_gap", q2.vrep.rail_gap},
+                {"c_property_jump", q2.vrep.property_jump},
+                {"closed", q2.vrep.closed},
+                {"cap_gap", q2.vrep.cap_gap},
+                {"outside", q2.vrep.outside},
+                {"hbs_volume", q2.vrep.hbs_volume},
+                {"beyond_volume", q2.vrep.beyond_volume},
+                {"beyond_jacobian", q2.vrep.beyond_jacobian},
+                {"reversed", q2.vrep.reversed}};
+      nlohmann::ordered_json shapes = nlohmann::ordered_json::array();
+      for (const auto& s : q2.cells) shapes.push_back(shape(s));
       jf.push_back({{"name", f.name},
                     {"component", k + 1},
+                    {"construction", fillet::construction_name(q2.construction)},
                     {"cells", f.cell_names[k]},
                     {"between", {{{"cell", f.cells[0]}, {"face", spline::face_name(f.faces[0])}},
                                  {{"cell", f.cells[1]}, {"face", spline::face_name(f.faces[1])}}}},
                     {"gap", q2.gap},
+                    {"blend_gap", q2.blend_gap},
                     {"g1_angle", q2.g1_angle},
                     {"jacobian", q2.jacobian()},
                     {"min_jacobian", q2.det_min},
                     {"max_jacobian", q2.det_max},
+                    {"cell_jacobian", q2.cell_jacobian},
+                    {"glue", q2.glue},
                     {"property_jump", q2.property_jump},
                     {"composed", q2.composed},
                     {"rail_error", q2.rail_error},
@@ -131,6 +187,9 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                     {"sub2", shape(q2.sub[1])},
                     {"blend", shape(q2.blend)},
                     {"fillet", shape(q2.fillet)},
+                    {"cell_shapes", shapes},
+                    {"vbs", vbs},
+                    {"vrep", vrep},
                     {"seconds", q2.seconds},
                     {"shepard", shepard_fit(f, k)}});
     }
@@ -154,7 +213,9 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
           {"cells", jc},
           {"primitives", jp},
           {"fillets", jf},
-          {"bridges", jb}};
+          {"bridges", jb},
+          {"surfaces", scene_surfaces(built)},
+          {"constructs", constructs(built)}};
 }
 
 void print_human(const nlohmann::ordered_json& j) {
@@ -183,20 +244,42 @@ void print_human(const nlohmann::ordered_json& j) {
     }
   }
   if (!j["fillets"].empty()) {
-    std::printf("\n%-14s %-12s %-22s %11s %11s %11s %-9s %11s %8s\n", "fillet", "cells", "between", "gap", "G1 (rad)",
-                "prop. jump", "det J", "S^ method", "seconds");
+    const auto cell_list = [](const nlohmann::ordered_json& f) {
+      std::string cells;
+      for (const auto& c : f["cells"]) cells += (cells.empty() ? "" : ",") + c.get<std::string>();
+      return cells;
+    };
+    int width = 12;
+    for (const auto& f : j["fillets"]) width = std::max(width, static_cast<int>(cell_list(f).size()));
+    std::printf("\n%-14s %-*s %-22s %-6s %11s %11s %11s %11s %-13s %-9s %8s\n", "fillet", width, "cells", "between",
+                "type", "gap", "glue", "G1 (rad)", "prop. jump", "det J", "S^ method", "seconds");
     for (const auto& f : j["fillets"]) {
       const auto& b = f["between"];
       const std::string between = b[0]["cell"].get<std::string>() + "." + b[0]["face"].get<std::string>() + "/" +
                                   b[1]["cell"].get<std::string>() + "." + b[1]["face"].get<std::string>();
       const auto mx = [&](const char* key) { return std::max(f[key][0].get<double>(), f[key][1].get<double>()); };
       const bool c0 = f["composed"][0].get<bool>(), c1 = f["composed"][1].get<bool>();
-      std::printf("%-14s %-12s %-22s %11s %11s %11s %-9s %11s %8s\n",
-                  (f["name"].get<std::string>() + "." + std::to_string(f["component"].get<int>())).c_str(),
-                  (f["cells"][0].get<std::string>() + "," + f["cells"][1].get<std::string>()).c_str(), between.c_str(),
-                  fmt(mx("gap"), 3).c_str(), fmt(mx("g1_angle"), 3).c_str(), fmt(mx("property_jump"), 3).c_str(),
+      std::printf("%-14s %-*s %-22s %-6s %11s %11s %11s %11s %-13s %-9s %8s\n",
+                  (f["name"].get<std::string>() + "." + std::to_string(f["component"].get<int>())).c_str(), width,
+                  cell_list(f).c_str(), between.c_str(), f["construction"].get<std::string>().c_str(),
+                  fmt(std::max(mx("gap"), f["blend_gap"].get<double>()), 3).c_str(), fmt(f["glue"].get<double>(), 3).c_str(),
+                  fmt(mx("g1_angle"), 3).c_str(), fmt(mx("property_jump"), 3).c_str(),
                   f["jacobian"].get<std::string>().c_str(), c0 && c1 ? "composed" : (c0 || c1 ? "mixed" : "fitted"),
                   fmt(f["seconds"].get<double>(), 3).c_str());
+    }
+    // V-rep fillets (seed 000 Alg. 6): the trimmed cell is T_hbs less the solid beyond S_b.
+    for (const auto& f : j["fillets"]) {
+      if (f["vrep"].is_null()) continue;
+      const auto& v = f["vrep"];
+      std::printf("%s.%d (vrep): T_hbs %s - beyond S_b %s - %s = %s; S_b outside T_hbs by %s; %s\n",
+                  f["name"].get<std::string>().c_str(), f["component"].get<int>(),
+                  fmt(v["hbs_volume"].get<double>(), 8).c_str(), fmt(v["beyond_volume"][0].get<double>(), 8).c_str(),
+                  fmt(v["beyond_volume"][1].get<double>(), 8).c_str(),
+                  fmt(v["hbs_volume"].get<double>() - v["beyond_volume"][0].get<double>() -
+                          v["beyond_volume"][1].get<double>(), 10).c_str(),
+                  fmt(v["outside"].get<double>(), 3).c_str(),
+                  v["closed"].get<bool>() ? "closed C, no caps"
+                                          : ("caps within " + fmt(v["cap_gap"].get<double>(), 3) + " of S_b's ends").c_str());
     }
   }
   if (!j["bridges"].empty()) {
@@ -209,6 +292,33 @@ void print_human(const nlohmann::ordered_json& j) {
                   b["orientation"].get<std::string>().c_str(),
                   fmt(std::max(b["g1_angle"][0].get<double>(), b["g1_angle"][1].get<double>()), 3).c_str(),
                   fmt(b["seconds"].get<double>(), 3).c_str());
+    }
+  }
+  if (!j["surfaces"].empty()) {
+    std::printf("\n%-14s %-7s %-9s %-10s %s\n", "surface", "kind", "orders", "counts", "accuracy");
+    for (const auto& s : j["surfaces"]) {
+      const std::string orders = std::to_string(s["orders"][0].get<int>()) + "," + std::to_string(s["orders"][1].get<int>());
+      const std::string counts = std::to_string(s["counts"][0].get<int>()) + "x" + std::to_string(s["counts"][1].get<int>());
+      const std::string acc = s["kind"] == "gismo"
+                                  ? "patch edges within " + fmt(s["max_gap"].get<double>(), 3)
+                                  : "offset " + fmt(s["distance"].get<double>(), 6) + ": within " +
+                                        fmt(s["max_error"].get<double>(), 3) + " of S + d n after " +
+                                        std::to_string(s["refinements"].get<int>()) + " refinements";
+      std::printf("%-14s %-7s %-9s %-10s %s\n", s["name"].get<std::string>().c_str(), s["kind"].get<std::string>().c_str(),
+                  orders.c_str(), counts.c_str(), acc.c_str());
+    }
+  }
+  if (!j["constructs"].empty()) {
+    std::printf("\n%-14s %-17s %6s  %s\n", "construct", "op", "cells", "field");
+    for (const auto& c : j["constructs"]) {
+      std::string field = "(the surfaces' own)";
+      if (!c["field"].is_null())
+        field = c["field"]["exact"].get<bool>() ? "exact"
+                                                : "max error " + fmt(c["field"]["max_error"].get<double>(), 3) +
+                                                      " of the range after " +
+                                                      std::to_string(c["field"]["refinements"].get<int>()) + " refinements";
+      std::printf("%-14s %-17s %6zu  %s\n", c["name"].get<std::string>().c_str(), c["op"].get<std::string>().c_str(),
+                  c["cells"].size(), field.c_str());
     }
   }
   std::printf("\ntotal volume %s; %s\n", fmt(j["volume"].get<double>(), 12).c_str(),
@@ -242,10 +352,18 @@ void add_build(CLI::App& app, Common& common) {
       for (std::size_t k = 0; k < f.cell_names.size(); ++k)
         for (const auto& name : f.cell_names[k])
           for (std::size_t i = 0; i < built.model.cells.size(); ++i)
-            if (built.model.cells[i].name == name) q[i].fillet = &f.quality[k];
+            if (built.model.cells[i].name == name) {
+              q[i].fillet = &f.quality[k];
+              q[i].fillet_cell = static_cast<std::size_t>(&name - f.cell_names[k].data());
+            }
     tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
+      // A fillet cell's volume comes with its report (the same integral over its faces: the
+      // VBS cells' thousand-by-hundred elements made geom::volume take seconds).
+      if (q[i].fillet) {
+        q[i].volume = q[i].fillet->cell_volume.at(q[i].fillet_cell);
+        return;
+      }
       q[i].volume = geom::volume(*geometry[i]);
-      if (q[i].fillet) return;
       // Rational trivariate cells have no Bezier-bound verdict (geom/validity.hpp): reported
       // as unchecked, not as invalid.
       q[i].checked = !geometry[i]->rational();
@@ -253,11 +371,14 @@ void add_build(CLI::App& app, Common& common) {
     });
     // Pieces of Booleans: the volume of the part their trimming admits (slice/trim.hpp).
     bool trimmed = false;
-    for (const auto& c : built.model.cells) trimmed = trimmed || !c.plain();
+    for (std::size_t i = 0; i < built.model.cells.size(); ++i)
+      trimmed = trimmed || (!built.model.cells[i].plain() && !q[i].fillet);
     if (trimmed) {
       const slice::Locator loc(built.model, {.tolerance = 1e-9 * slice::model_diagonal(built.model)});
       tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
-        if (!built.model.cells[i].plain()) q[i].volume = slice::trimmed_volume(loc, static_cast<int>(i));
+        // A V-rep fillet's volume is exact from its report (T_hbs less the solid beyond S_b).
+        if (!built.model.cells[i].plain() && !q[i].fillet)
+          q[i].volume = slice::trimmed_volume(loc, static_cast<int>(i));
       });
     }
     io::save_model(built.model, opt->output);

@@ -130,12 +130,13 @@ const char* subregion_method_name(SubregionMethod m) noexcept {
     case SubregionMethod::compose: return "compose";
     case SubregionMethod::fit: return "fit";
     case SubregionMethod::automatic: return "auto";
+    case SubregionMethod::matched: return "matched";
   }
   return "?";
 }
 
 bool subregion_method_from_name(const char* name, SubregionMethod& out) noexcept {
-  for (SubregionMethod m : {SubregionMethod::compose, SubregionMethod::fit, SubregionMethod::automatic})
+  for (SubregionMethod m : {SubregionMethod::compose, SubregionMethod::fit, SubregionMethod::automatic, SubregionMethod::matched})
     if (std::strcmp(name, subregion_method_name(m)) == 0) {
       out = m;
       return true;
@@ -229,7 +230,7 @@ Surface subregion(const Surface& s, const Curve& from, const Curve& to, const Su
   const Surface r = construct::ruled(from, to);
   check_map(s, r.dim(), r.rational(), spline::bounding_box(r), "ruled map");
   const bool crosses = box_crosses(s, spline::bounding_box(r));
-  if (crosses && options.method == SubregionMethod::compose)
+  if (crosses && (options.method == SubregionMethod::compose || options.method == SubregionMethod::matched))
     throw Error("fillet sub-region: the region between the curves crosses knot lines of the surface, where exact "
                 "composition is no tensor-product spline; expected method \"fit\" or \"auto\"");
   SubregionReport rep;

@@ -19,140 +19,17 @@ using spline::Curve;
 using spline::KnotVector;
 using spline::Surface;
 using spline::Trivariate;
+using detail::curve_gap;
 using detail::num;
+using detail::project;
+using detail::row;
+using detail::set_row;
+using detail::xyz_at;
+using detail::knot_merge;
+using detail::merge_close_knots;
+using detail::split_across;
 
 namespace {
-
-/// Row j across (direction 1) of s: the curve along u whose control points are s's P_{m, j}.
-Curve row(const Surface& s, int j) {
-  std::vector<double> pts;
-  for (int m = 0; m < s.count(0); ++m) {
-    const auto p = s.point(s.row({m, j}));
-    pts.insert(pts.end(), p.begin(), p.end());
-  }
-  return Curve({s.knots(0)}, s.dim(), std::move(pts));
-}
-
-/// Overwrites coordinates [0, coords) of row j of s with c's control points (same u space).
-void set_row(Surface& s, int j, const Curve& c, int coords) {
-  for (int m = 0; m < s.count(0); ++m) {
-    auto p = s.point(s.row({m, j}));
-    const auto q = c.point(m);
-    std::copy(q.begin(), q.begin() + coords, p.begin());
-  }
-}
-
-double distance3(std::span<const double> a, std::span<const double> b) {
-  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-}
-
-/// Largest xyz distance between the control points of two curves in one space.
-double curve_gap(const Curve& a, const Curve& b) {
-  double g = 0.0;
-  for (int m = 0; m < a.size(); ++m) g = std::max(g, distance3(a.point(m), b.point(m)));
-  return g;
-}
-
-/// Eq. A.1: the parameter v in [0, 1] of the orthogonal projection of p (xyz) on the curve c(v):
-/// <p - c(v), c'(v)> = 0 at the nearest of 129 samples, refined by Newton's method.
-double project(const Curve& c, const std::array<double, 3>& p) {
-  const auto [lo, hi] = c.domain(0);
-  const auto dist2 = [&](double v) {
-    const auto x = c.eval({v});
-    return (x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) + (x[2] - p[2]) * (x[2] - p[2]);
-  };
-  double v = lo, best = dist2(lo);
-  for (int i = 1; i <= 128; ++i) {
-    const double t = lo + (hi - lo) * i / 128.0;
-    const double d = dist2(t);
-    if (d < best) best = d, v = t;
-  }
-  const std::size_t k = static_cast<std::size_t>(c.dim());
-  for (int it = 0; it < 60; ++it) {
-    const auto d = c.eval_derivatives({v}, 2);
-    double f = 0.0, fp = 0.0;
-    for (std::size_t j = 0; j < 3; ++j) {
-      const double e = d[j] - p[j];
-      f += e * d[k + j];
-      fp += d[k + j] * d[k + j] + e * d[2 * k + j];
-    }
-    if (!(fp > 0.0)) break;
-    const double next = std::clamp(v - f / fp, lo, hi);
-    const double step = std::abs(next - v);
-    v = next;
-    if (step <= 1e-15 * (hi - lo)) break;
-  }
-  return (v - lo) / (hi - lo);
-}
-
-std::array<double, 3> xyz_at(const Curve& c, double t) {
-  const auto x = c.eval({t});
-  return {x[0], x[1], x[2]};
-}
-
-/// Knots closer than this (on [0, 1]) are one knot: the pieces' spaces come from restrictions,
-/// normalisations and reversals, which give the same value in different roundings.
-constexpr double knot_merge = 1e-11;
-
-/// The pieces of s across (direction 1) on [0, t] and [t, 1], each normalized to [0, 1]^2. A t
-/// within knot_merge of one of s's knots is moved onto it (no sliver span).
-std::pair<Surface, Surface> split_across(const Surface& s, double& t) {
-  for (const double x : s.knots(1).knots())
-    if (std::abs(x - t) <= knot_merge) t = x;
-  auto [a, b] = spline::split(s, 1, t);
-  return {construct::normalized(a), construct::normalized(b)};
-}
-
-/// The surfaces with their interior knots across (direction 1, all on [0, 1]) that lie within
-/// knot_merge of each other moved onto one value (the smallest of the cluster), so the union of
-/// their spaces has no sliver spans. Moving a knot by d changes a surface by O(d) times its
-/// control-point differences: rounding.
-void merge_close_knots(std::vector<Surface>& pieces) {
-  std::vector<double> all;
-  for (const auto& s : pieces) {
-    const auto& kv = s.knots(1);
-    for (int i = kv.order(); i < kv.size(); ++i) all.push_back(kv[i]);
-  }
-  std::sort(all.begin(), all.end());
-  const auto representative = [&](double x) {
-    // The first value of x's cluster: walk down while the gaps stay within knot_merge.
-    auto it = std::lower_bound(all.begin(), all.end(), x);
-    while (it != all.begin() && *it - *(it - 1) <= knot_merge) --it;
-    return *it;
-  };
-  for (auto& s : pieces) {
-    const auto& kv = s.knots(1);
-    std::vector<double> k = kv.knots();
-    bool moved = false;
-    for (int i = kv.order(); i < kv.size(); ++i) {
-      const double r = representative(k[static_cast<std::size_t>(i)]);
-      moved = moved || r != k[static_cast<std::size_t>(i)];
-      k[static_cast<std::size_t>(i)] = r;
-    }
-    if (moved)
-      s = Surface({s.knots(0), KnotVector(kv.order(), std::move(k))}, s.dim(),
-                  std::vector<double>(s.points().begin(), s.points().end()));
-  }
-}
-
-
-/// Writes face f's control net into the boundary layer of t where direction dir has index
-/// `index` (f's parameters are t's two other directions in increasing order, in t's spaces).
-void set_layer(Trivariate& t, int dir, int index, const Surface& f) {
-  const int a = dir == 0 ? 1 : 0, b = dir == 2 ? 1 : 2;
-  if (f.knots(0) != t.knots(a) || f.knots(1) != t.knots(b))
-    throw Error("VBS fillet: a face is not in its cell's function space (internal)", ErrorKind::failed);
-  for (int j = 0; j < f.count(1); ++j)
-    for (int i = 0; i < f.count(0); ++i) {
-      std::array<int, 3> idx{};
-      idx[static_cast<std::size_t>(dir)] = index;
-      idx[static_cast<std::size_t>(a)] = i;
-      idx[static_cast<std::size_t>(b)] = j;
-      const auto q = f.point(f.row({i, j}));
-      auto p = t.point(t.row(idx));
-      std::copy(q.begin(), q.end(), p.begin());
-    }
-}
 
 /// One cell: the volumetric Boolean sum of its sleeve (faces v0, v1, w0, w1, all in U x X) and
 /// the Coons caps of the sleeve's end curves. With Coons caps the six-face sum
@@ -203,10 +80,10 @@ Trivariate cell(const Surface& v0, const Surface& v1, const Surface& w0, const S
                  (b00 * E[0][0][e + c] + b10 * E[1][0][e + c] + b01 * E[0][1][e + c] + b11 * E[1][1][e + c]);
       }
     }
-  set_layer(t, 1, 0, v0);
-  set_layer(t, 1, nx - 1, v1);
-  set_layer(t, 2, 0, w0);
-  set_layer(t, 2, nx - 1, w1);
+  detail::set_layer(t, 1, 0, v0, "VBS fillet");
+  detail::set_layer(t, 1, nx - 1, v1, "VBS fillet");
+  detail::set_layer(t, 2, 0, w0, "VBS fillet");
+  detail::set_layer(t, 2, nx - 1, w1, "VBS fillet");
   for (int a = 0; a < 2; ++a)
     for (int b2 = 0; b2 < 2; ++b2)
       for (int i = 0; i < nu; ++i) {
@@ -267,7 +144,8 @@ std::array<Trivariate, 3> vbs_fillet(const Surface& sub1, const Surface& sub2, c
   const auto leaves = [](double v, const char* what, const char* surface) {
     if (!(v > 1e-6 && v < 1.0 - 1e-6))
       throw Error(std::string("VBS fillet: the projection ") + what + " on " + surface + " lands at v = " + num(v) +
-                  ", its boundary; expected a point inside (a fillet whose cross-section holds a division)");
+                      ", its boundary; expected a point inside (a fillet whose cross-section holds a division)",
+                  ErrorKind::failed);
   };
   rep.v_b = project(spline::iso(b, 0, 0.5), xyz_at(C, 0.5));  // Eq. A.1
   leaves(rep.v_b, "of C(1/2)", "S_b(1/2, v)");

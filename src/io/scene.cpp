@@ -5,6 +5,7 @@
 #include <map>
 
 #include "json_io.hpp"
+#include "scene_construct.hpp"
 
 #include "trivox/error.hpp"
 #include "trivox/fillet/shepard.hpp"
@@ -188,7 +189,7 @@ std::vector<SceneCell> read_cells(const Source& src, const json& root, const Poi
 }
 
 std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& root, const PointShape& shape,
-                                                NameTable& names) {
+                                                NameTable& names, std::vector<SceneSurfaceRecipe>& derived) {
   const json* j = find(root, "surfaces");
   if (j == nullptr) return {};
   const std::string what = "{\"name\", \"surface\"}";
@@ -198,6 +199,10 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
     const std::string ip = child("/surfaces", i);
     const json& item = expect_object(src, (*j)[i], ip, "an object " + what);
     std::string name = read_name(src, item, ip, names);
+    if (scene_detail::is_derived_surface(item)) {  // "gismo" patches or an "offset" (scene_construct.hpp)
+      derived.push_back(scene_detail::read_derived_surface(src, item, ip, std::move(name)));
+      continue;
+    }
     out.push_back({std::move(name), read_spline<2>(src, require(src, item, ip, "surface", what), child(ip, "surface"), shape)});
   }
   return out;
@@ -207,7 +212,7 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
 void read_fillet(const Source& src, const json& item, const std::string& ip, SceneOperation& o) {
   const std::string what =
       "a fillet {\"op\": \"fillet\", \"between\": [A, B], \"distance\", \"tau\", \"section\", \"dip\", "
-      "\"method\", \"blend\", \"power\", \"flip\", \"bridge\", \"name\"}";
+      "\"method\", \"blend\", \"power\", \"flip\", \"construction\", \"bridge\", \"name\"}";
   const std::string bp = child(ip, "between");
   const json& between = require(src, item, ip, "between", what);
   const std::string bwhat = "two cells: names or {\"cell\": NAME, \"face\": \"u0\"..\"w1\"}";
@@ -241,7 +246,7 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     // Flends Sec. III between disjoint faces: the faces, dip and name; no distances or tangents.
     if (!o.faces[0] || !o.faces[1])
       src.fail(bp, "a bridge names both faces; expected [{\"cell\", \"face\"}, {\"cell\", \"face\"}]");
-    for (const char* key : {"distance", "tau", "method", "flip", "blend", "power"})
+    for (const char* key : {"distance", "tau", "method", "flip", "blend", "power", "construction"})
       if (find(item, key)) src.fail(child(ip, key), std::string("\"") + key + "\" with \"bridge\": true; expected "
                                                          "only \"between\", \"section\": \"flend\", \"dip\" and \"name\"");
     f.blend.section = fillet::Section::flend;
@@ -276,9 +281,9 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
       src.fail(child(ip, "dip"), "dip " + format_double(f.blend.dip) + "; expected a value in [0, 1]");
   }
   if (const json* t = find(item, "method")) {
-    const std::string m = read_string(src, *t, child(ip, "method"), "\"auto\", \"compose\" or \"fit\"");
+    const std::string m = read_string(src, *t, child(ip, "method"), "\"auto\", \"compose\", \"matched\" or \"fit\"");
     if (!fillet::subregion_method_from_name(m.c_str(), f.method))
-      src.fail(child(ip, "method"), "unknown method " + quote(m) + "; expected \"auto\", \"compose\" or \"fit\"");
+      src.fail(child(ip, "method"), "unknown method " + quote(m) + "; expected \"auto\", \"compose\", \"matched\" or \"fit\"");
   }
   if (const json* t = find(item, "blend")) {
     const std::string b = read_string(src, *t, child(ip, "blend"), "\"parametric\" or \"shepard\"");
@@ -289,6 +294,15 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
   if (const json* t = find(item, "power")) {  // Shepard's q (fillet/shepard.hpp)
     o.shepard_power = read_int(src, *t, child(ip, "power"), 1, 16, "a power q, an integer in 1..16");
     if (!o.shepard) src.fail(child(ip, "power"), "a power without \"blend\": \"shepard\"; expected it only with the Shepard blend");
+  }
+  if (const json* t = find(item, "construction")) {  // seed 000 Alg. 2, Sec. 3.2 / Alg. 3 or Sec. 5 / Alg. 6
+    const std::string cp = child(ip, "construction");
+    const std::string c = read_string(src, *t, cp, "\"ruled\", \"vbs\" or \"vrep\"");
+    if (!fillet::construction_from_name(c.c_str(), f.construction))
+      src.fail(cp, "unknown construction " + quote(c) + "; expected \"ruled\", \"vbs\" or \"vrep\"");
+    if (f.construction != fillet::Construction::ruled && o.shepard)
+      src.fail(cp, quote(c) + " with \"blend\": \"shepard\"; expected \"ruled\" for the Shepard blend (its encoding "
+                   "works on the ruled halves)");
   }
   if (const json* t = find(item, "flip")) {
     const std::string fp = child(ip, "flip");
@@ -307,7 +321,7 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
   }
 }
 
-std::vector<SceneOperation> read_operations(const Source& src, const json& root) {
+std::vector<SceneOperation> read_operations(const Source& src, const json& root, std::size_t properties) {
   const json* j = find(root, "operations");
   if (j == nullptr) return {};
   const std::string what = "an operation {\"op\": " + known_operations() + ", ...}";
@@ -346,6 +360,7 @@ std::vector<SceneOperation> read_operations(const Source& src, const json& root)
       }
     }
     if (op == "fillet") read_fillet(src, item, ip, o);
+    if (scene_detail::is_constructor(op)) scene_detail::read_constructor(src, item, ip, o, properties);
     out.push_back(std::move(o));
   }
   return out;
@@ -366,8 +381,10 @@ const vmodel::VCell& find_cell(const Source& src, const Objects& objects, const 
                 "<name>.<part>)");
 }
 
-/// Seed 000 Alg. 2 between two cells: the faces (given, or the one intersecting pair), the
-/// fillets, their cells named <name>.<k>a and <name>.<k>b.
+/// Seed 000 Alg. 2 (or Sec. 3.2 / Alg. 3 with "construction": "vbs", Sec. 5 / Alg. 6 with
+/// "vrep") between two cells: the faces (given, or the one intersecting pair), the fillets, their
+/// cells named <name>.<k>a and <name>.<k>b (vbs: <name>.<k>.1, .2, .3; vrep: the trimmed cell
+/// <name>.<k>).
 template <class Objects>
 std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation& op,
                                         const Objects& objects, SceneBuild& out) {
@@ -461,21 +478,29 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
                       format_double(q.det_max) + "); expected a valid fillet: try other distances or tau",
                   ErrorKind::failed);
     const std::string base = op.name + "." + std::to_string(k + 1);
-    rep.cell_names.push_back({base + "a", base + "b"});
+    // Ruled (Alg. 2): the halves <base>a, <base>b; VBS (Alg. 3): T_1, T_2, T_3 as <base>.1 .. .3;
+    // V-rep (Alg. 6): the trimmed cell <base> (its trimming solid <base>.beyond.1, .2).
+    std::vector<std::string> names;
+    if (q.construction == fillet::Construction::vbs)
+      names = {base + ".1", base + ".2", base + ".3"};
+    else if (q.construction == fillet::Construction::vrep)
+      names = {base};
+    else
+      names = {base + "a", base + "b"};
+    rep.cell_names.push_back(names);
     rep.quality.push_back(q);
     if (!op.shepard) {
-      cells.emplace_back(base + "a", fillets[k].halves[0]);
-      cells.emplace_back(base + "b", fillets[k].halves[1]);
+      for (std::size_t c = 0; c < names.size(); ++c) cells.push_back(fillets[k].vcell(c, names[c]));
       continue;
     }
     // Seed 000 Sec. 7.2: both halves carry f, encoded, and S^_1, S^_2 (their faces w = 0) for
     // the exact per-voxel value.
     vmodel::ShepardData sd;
     sd.power = op.shepard_power;
-    for (std::size_t h = 0; h < 2; ++h) sd.sources[h] = spline::boundary_face(fillets[k].halves[h], spline::Face::w0);
+    for (std::size_t h = 0; h < 2; ++h) sd.sources[h] = spline::boundary_face(fillets[k].cells[h], spline::Face::w0);
     const fillet::ShepardField field(sd);
     for (std::size_t h = 0; h < 2; ++h) {
-      auto enc = fillet::encode_shepard(fillets[k].halves[h], field, {.power = op.shepard_power});
+      auto enc = fillet::encode_shepard(fillets[k].cells[h], field, {.power = op.shepard_power});
       rep.shepard.push_back({enc.max_error, enc.rms_error, enc.check_error, enc.samples, enc.seconds});
       cells.emplace_back(base + (h == 0 ? "a" : "b"), std::move(enc.half));
     }
@@ -513,10 +538,18 @@ void apply_operations(const Scene& scene, const Source& src, SceneBuild& out) {
     for (int k = 0; k < count; ++k) o.cells.push_back(std::move(out.model.cells[next++]));
     objects.push_back(std::move(o));
   }
+  std::optional<std::map<std::string, spline::Surface>> surfaces;  // resolved at the first constructor
   const auto find_object = [&](const std::string& name) {
     return std::find_if(objects.begin(), objects.end(), [&](const Object& o) { return o.name == name; });
   };
   for (const SceneOperation& op : scene.operations) {
+    if (scene_detail::is_constructor(op.op)) {
+      if (find_object(op.name) != objects.end())
+        src.fail(op.pointer + "/name", quote(op.name) + " names another cell or result; expected a fresh name");
+      if (!surfaces) surfaces = scene_detail::resolve_surfaces(scene, src, out);
+      objects.push_back({op.name, scene_detail::apply_constructor(scene, src, op, *surfaces, out), -1});
+      continue;
+    }
     if (op.op == "fillet") {
       if (find_object(op.name) != objects.end())
         src.fail(op.pointer + "/name", quote(op.name) + " names another cell or result; expected a fresh name");
@@ -578,6 +611,10 @@ void apply_operations(const Scene& scene, const Source& src, SceneBuild& out) {
 
 }  // namespace
 
+construct::Field scene_detail::read_field(const Source& src, const json& j, const std::string& ptr, std::size_t properties) {
+  return io::read_field(src, j, ptr, properties);
+}
+
 Scene read_scene_json(std::string_view text, const std::string& source) {
   const Source src{source};
   const json root = parse(src, text);
@@ -590,9 +627,9 @@ Scene read_scene_json(std::string_view text, const std::string& source) {
   const PointShape shape = point_shape(scene.properties.size());
   NameTable names;
   scene.cells = read_cells(src, root, shape, scene.properties.size(), names);
-  scene.surfaces = read_surfaces(src, root, shape, names);
-  scene.operations = read_operations(src, root);
-  if (scene.cells.empty() && scene.surfaces.empty())
+  scene.surfaces = read_surfaces(src, root, shape, names, scene.derived_surfaces);
+  scene.operations = read_operations(src, root, scene.properties.size());
+  if (scene.cells.empty() && scene.surfaces.empty() && scene.derived_surfaces.empty())
     src.fail("", "no cells and no surfaces; expected at least one cell (\"cells\") or surface (\"surfaces\")");
   return scene;
 }
@@ -603,12 +640,10 @@ SceneBuild build_scene(const Scene& scene) {
   const Source src{scene.source};
   for (const SceneOperation& op : scene.operations) {
     const bool boolean = op.op == "union" || op.op == "intersection" || op.op == "subtraction";
-    if (boolean || op.op == "fillet") continue;
+    if (boolean || op.op == "fillet" || scene_detail::is_constructor(op.op)) continue;
     src.fail(op.pointer + "/op",
-             quote(op.op) + " is not supported yet (" +
-                 std::string("constructor operations in scenes") +
-                 " are later work; `trivox construct` runs one constructor on its own); expected union, "
-                 "intersection, subtraction or fillet");
+             quote(op.op) + " is not supported yet in scenes (`trivox construct` runs it on its own); expected "
+                 "union, intersection, subtraction, fillet, ruled, boolean_sum, half_boolean_sum, extrude or sweep");
   }
   SceneBuild out;
   out.model.units = scene.units;

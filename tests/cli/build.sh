@@ -65,8 +65,10 @@ scene '{"name": "a", "primitive": {"type": "prism"}, "field": {"constant": 1}}'
 expect_fail '/cells/0/primitive/type: unknown primitive type "prism"; expected "box"' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}}'
 expect_fail '/cells/0: missing "field"' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
+scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "revolve"}'
+expect_fail '/operations/0/op: "revolve" is not supported yet' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "ruled"}'
-expect_fail '/operations/0/op: "ruled" is not supported yet' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
+expect_fail '/operations/0: missing "name"; expected a constructor' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "fillet"}'
 expect_fail '/operations/0: missing "between"; expected a fillet' "$trivox" build "$tmp/s.json" -o "$tmp/x.json"
 scene '{"name": "a", "primitive": {"type": "box", "min": [0,0,0], "max": [1,1,1]}, "field": {"constant": 1}}' '{"op": "smooth"}'

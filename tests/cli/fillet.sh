@@ -12,21 +12,14 @@
 set -euo pipefail
 source tests/cli/lib.bash "$@"
 
-corner() {  # corner FILLET-FIELDS: floor [0,4]x[0,4]x[-1,0] red, wall [1,2]x[-0.5,4.5]x[-0.5,3] blue
-  cat > "$tmp/corner.json" <<EOF
-{ "trivox": 1, "units": "mm", "properties": ["r", "g", "b"],
-  "cells": [
-    {"name": "floor", "primitive": {"type": "box", "min": [0, 0, -1], "max": [4, 4, 0]}, "field": {"constant": [1, 0, 0]}},
-    {"name": "wall", "primitive": {"type": "box", "min": [1, -0.5, -0.5], "max": [2, 4.5, 3]}, "field": {"constant": [0, 0, 1]}}
-  ],
-  "operations": [{"op": "fillet", "between": [{"cell": "floor", "face": "w1"}, {"cell": "wall", "face": "u1"}], $1}] }
-EOF
-}
+corner() { corner_scene "$tmp/corner.json" "$(fillet_op "$1")"; }  # corner FILLET-FIELDS
 
 check() {  # check BUILD-JSON KIND: the quality report and the fillet's volume
   "$py" - "$1" "$2" <<'PY'
 import sys, json
 import numpy as np
+sys.path.insert(0, "tests/cli")
+from fillet_math import hermite_area
 r = json.load(open(sys.argv[1]))
 kind = sys.argv[2]
 d1, d2, length = 1.0, 0.5, 4.0
@@ -42,18 +35,7 @@ if kind == "chamfer":
     exact = d1 * d2 / 2 * length
 else:
     assert max(f["g1_angle"]) < 1e-6, f["g1_angle"]
-    tau = 1.2
-    w = tau * np.hypot(d1, d2)
-    # Section in (X, Z) = (x - 2, z): cubic Bezier with control points C1, C1 + T1/3, C2 - T2/3, C2.
-    P = np.array([[d1, 0], [d1 - w / 3, 0], [0, d2 - w / 3], [0, d2]])
-    v, wts = np.polynomial.legendre.leggauss(8)
-    v = 0.5 * (v + 1)
-    B = np.array([(1 - v) ** 3, 3 * v * (1 - v) ** 2, 3 * v ** 2 * (1 - v), v ** 3])
-    dB = np.array([-3 * (1 - v) ** 2, 3 * (1 - v) ** 2 - 6 * v * (1 - v), 6 * v * (1 - v) - 3 * v ** 2, 3 * v ** 2])
-    X, Z = B.T @ P[:, 0], B.T @ P[:, 1]
-    dX, dZ = dB.T @ P[:, 0], dB.T @ P[:, 1]
-    area = 0.5 * np.sum(0.5 * wts * (X * dZ - Z * dX))
-    exact = area * length
+    exact = hermite_area(d1, d2, 1.2) * length  # tests/cli/fillet_math.py
 assert abs(vol - exact) < 1e-9 * exact, (vol, exact)
 assert r["valid"], "every cell valid"
 print(kind, "fillet volume", vol, "exact", exact)

@@ -1,15 +1,36 @@
 // The right-angled corner of the fillet tests (floor z = 0, wall x = 2): its faces, rails in
-// parameters, sub-regions and the input of the blending surface. Shared by test_fillet_parts.cpp
-// and test_vbs_fillet.cpp.
+// parameters, sub-regions and the input of the blending surface. Shared by test_fillet_parts.cpp,
+// test_vbs_fillet.cpp and test_vrep_fillet.cpp; also the Hermite section's area.
 #pragma once
+#include <cmath>
 #include <vector>
 
 #include "trivox/fillet/blend_surface.hpp"
 #include "trivox/fillet/compose.hpp"
+#include "trivox/geom/quadrature.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/spline/refine.hpp"
 
 namespace fillet_test {
+
+/// Area of the region between the legs (through the origin) and the cubic Bezier section
+/// C_1, C_1 + T_1 / 3, C_2 - T_2 / 3, C_2 in (X, Z) = (x - 2, z): Alg. 1, Eq. 1 with |T_i| =
+/// tau |C_1 - C_2|, by Green's theorem (1/2) int (X Z' - Z X'), exact with 8 Gauss points.
+inline double hermite_area(double d1, double d2, double tau) {
+  const double w = tau * std::hypot(d1, d2);
+  const double P[4][2] = {{d1, 0}, {d1 - w / 3, 0}, {0, d2 - w / 3}, {0, d2}};
+  const trivox::geom::GaussRule g = trivox::geom::gauss_legendre(8);
+  double area = 0.0;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    const double t = 0.5 * (g.nodes[i] + 1), s = 1 - t;
+    const double B[4] = {s * s * s, 3 * t * s * s, 3 * t * t * s, t * t * t};
+    const double dB[4] = {-3 * s * s, 3 * s * s - 6 * t * s, 6 * t * s - 3 * t * t, 3 * t * t};
+    double X = 0, Z = 0, dX = 0, dZ = 0;
+    for (int j = 0; j < 4; ++j) X += B[j] * P[j][0], Z += B[j] * P[j][1], dX += dB[j] * P[j][0], dZ += dB[j] * P[j][1];
+    area += 0.5 * 0.5 * g.weights[i] * (X * dZ - Z * dX);
+  }
+  return area;
+}
 
 using trivox::spline::Curve;
 using trivox::spline::KnotVector;

@@ -2,16 +2,21 @@
 // values from the mathematics: the corner's fillet region has the volume of the ruled fillet
 // (and of the Hermite section by Green's theorem); the chamfer's C_c(1/2) is the incentre of the
 // right isosceles triangle (Eq. A.2); faces are pieces of the inputs; shared faces coincide.
+// Through fillet_faces, both constructions between two boxes: the volume of the Hermite section
+// by Green's theorem, and the quality report (gaps, G1, glue, det J, property jump).
 #include <catch2/catch.hpp>
 
-#include <cmath>
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "corner.hpp"
 #include "trivox/construct/constructors.hpp"
 #include "trivox/error.hpp"
 #include "trivox/fillet/blend_surface.hpp"
+#include "trivox/fillet/fillet.hpp"
 #include "trivox/fillet/rails.hpp"
 #include "trivox/fillet/ruled_fillet.hpp"
 #include "trivox/fillet/vbs_fillet.hpp"
@@ -375,4 +380,76 @@ TEST_CASE("VBS fillet refuses bad options and boundaries apart", "[fillet][vbs]"
   CHECK_THROWS_WITH(fillet::vbs_fillet(s1, moved, b), Catch::Contains("S^_1(u, 1) and S^_2(u, 0) are 0.01 apart"));
   const Surface two = spline::coordinates(s2, 0, 2);
   CHECK_THROWS_AS(fillet::vbs_fillet(s1, two, b), Error);
+}
+
+namespace {
+
+/// A trilinear box cell [lo, hi] with one property value.
+Trivariate box_cell(std::array<double, 3> lo, std::array<double, 3> hi, double value) {
+  std::vector<double> pts;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) pts.insert(pts.end(), {i ? hi[0] : lo[0], j ? hi[1] : lo[1], k ? hi[2] : lo[2], value});
+  const auto kv = spline::KnotVector::bezier(2);
+  return Trivariate({kv, kv, kv}, 4, pts);
+}
+
+}  // namespace
+
+TEST_CASE("fillet_faces, ruled and vbs: the quality report of each construction", "[fillet][vbs]") {
+  // Floor [0,4]^2 x [-1,0] (property 10), wall [1,2] x [-0.5,4.5] x [-0.5,3] (property 20):
+  // C is x = 2, z = 0 for y in [0, 4]; d1 = 1 on the floor, d2 = 0.5 on the wall; Hermite tau 1.2.
+  const Trivariate floor = box_cell({0, 0, -1}, {4, 4, 0}, 10.0), wall = box_cell({1, -0.5, -0.5}, {2, 4.5, 3}, 20.0);
+  const double d1 = 1.0, d2 = 0.5, tau = 1.2, length = 4.0;
+  // The Hermite section's area by Green's theorem (corner.hpp).
+  const double area = fillet_test::hermite_area(d1, d2, tau);
+  const double exact = area * length;
+  for (const auto construction : {fillet::Construction::ruled, fillet::Construction::vbs}) {
+    fillet::FilletOptions o;
+    o.distance = {d1, d2};
+    o.blend.tau = tau;
+    o.construction = construction;
+    const auto fillets = fillet::fillet_faces(floor, Face::w1, wall, Face::u1, o);
+    REQUIRE(fillets.size() == 1);
+    const auto& f = fillets[0];
+    const auto& q = f.quality;
+    const bool vbs = construction == fillet::Construction::vbs;
+    REQUIRE(f.cells.size() == (vbs ? 3u : 2u));
+    REQUIRE(q.cell_jacobian.size() == f.cells.size());
+    REQUIRE(q.cells.size() == f.cells.size());
+    REQUIRE(q.cell_volume.size() == f.cells.size());
+    double volume = 0.0;
+    for (std::size_t c = 0; c < f.cells.size(); ++c) {
+      // The report's volume (over the faces, by the divergence theorem) is the quadrature of det J.
+      const double quadrature = geom::volume(f.cells[c]);
+      CHECK(q.cell_volume[c] == Approx(quadrature).epsilon(1e-13));
+      volume += quadrature;
+    }
+    std::printf("[vbs] fillet_faces %s: volume %.15g (Green %.15g), gap %.3g %.3g, S_b gap %.3g, G1 %.3g %.3g, "
+                "glue %.3g, det J [%.6g, %.6g], property jump %.3g %.3g, %.3f s\n",
+                fillet::construction_name(construction), volume, exact, q.gap[0], q.gap[1], q.blend_gap, q.g1_angle[0],
+                q.g1_angle[1], q.glue, q.det_min, q.det_max, q.property_jump[0], q.property_jump[1], q.seconds);
+    CHECK(volume == Approx(exact).epsilon(1e-11));
+    // Planar faces composed exactly: the cells interpolate S^_1, S^_2 and S_b to rounding.
+    CHECK(q.gap[0] < 1e-12);
+    CHECK(q.gap[1] < 1e-12);
+    CHECK(q.blend_gap < 1e-12);
+    CHECK(q.g1_angle[0] < 1e-6);
+    CHECK(q.g1_angle[1] < 1e-6);
+    CHECK(q.glue == 0.0);  // shared faces from one set of control points
+    CHECK(q.jacobian() == "positive");
+    for (const auto& r : q.cell_jacobian) CHECK(r[0] > 0.0);
+    if (!vbs) {
+      CHECK(q.property_jump[0] < 1e-12);  // each half carries its cell's property on its face
+      CHECK(q.property_jump[1] < 1e-12);
+      continue;
+    }
+    // Eq. 8's jump on C is 20 - 10: T_1 carries the mean 15 on C, so its faces on S^_i deviate
+    // from g_i by at most half the jump (attained on C).
+    CHECK(q.vbs.property_jump == Approx(10.0));
+    CHECK(std::max(q.property_jump[0], q.property_jump[1]) == Approx(5.0).margin(1e-12));
+    // The shared faces are bit-identical (the report's glue is measured by sampling).
+    const std::array<Trivariate, 3> t{f.cells[0], f.cells[1], f.cells[2]};
+    CHECK(shared_face_gap(t) == 0.0);
+  }
 }

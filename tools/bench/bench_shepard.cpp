@@ -9,7 +9,8 @@
 // Usage: trivox_bench_shepard [--model MODEL | --scene SCENE] [--z Z] [--size WxH] [--repeats N]
 //                             [--threads N]
 //   MODEL: a model with Shepard fillet cells (built with "blend": "shepard"). SCENE: a scene
-//   whose fillets are built here with "blend": "shepard" (default: models/fillet_spheres.json).
+//   whose fillets are built here with "blend": "shepard" (default: models/lamp.json, the lamp
+//   of Fig. 15 lying along y, so that the middle layer is Fig. 15 (b)'s section on its axis).
 //   Z: default the middle of the box. Prints the Shepard voxels, the share of warm closest-point
 //   queries and the milliseconds per slice for both blends.
 #include <sys/resource.h>
@@ -96,7 +97,7 @@ Result slice_once(const vmodel::VModel& model, const slice::VoxelGrid& grid, sli
 }  // namespace
 
 int main(int argc, char** argv) try {
-  std::string model_file, scene_file = std::string(TRIVOX_SOURCE_DIR) + "/models/fillet_spheres.json";
+  std::string model_file, scene_file = std::string(TRIVOX_SOURCE_DIR) + "/models/lamp.json";
   double z = 0.0;
   bool have_z = false;
   int width = 1516, height = 2524, repeats = 3, threads = 2;

@@ -3,7 +3,9 @@
 //
 // 1. The whole job at J750 settings with 2 threads, against the floor: encoding and writing the
 //    same PNGs from memory with the same settings and threads (the slices are decoded back first,
-//    untimed). Prints seconds, voxels per second and the ratio job / floor.
+//    untimed). Prints seconds, voxels per second, the ratio job / floor and both per layer.
+//    With a model at its own height (LAYERS_FOR_STEP_1 = 0) this is a full print job, e.g. the
+//    teapot's (issue 7's benchmark: build models/teapot.json first, pass the built model).
 // 2. One 1516 x 2524 pixel slice (the papers' example size): the model scaled to 64.2 x 213.7 mm
 //    in xy and to one layer in z, sliced on one thread.
 // 3. Peak memory of a full-tray-width J750 layer (11,575 x 4,606 px): the model scaled to the
@@ -132,6 +134,7 @@ int main(int argc, char** argv) {
               job.seconds, job.voxels / job.seconds, "");
   std::printf("%-44s %12.3f %14.4g %8.2f\n", "floor: encode + write the same PNGs", floor_s, job.voxels / floor_s,
               job.seconds / floor_s);
+  std::printf("per layer: job %.2f ms, floor %.2f ms\n", 1e3 * job.seconds / job.grid.count[2], 1e3 * floor_s / job.grid.count[2]);
   std::printf("inversion failures: %lld\n", static_cast<long long>(job.inversion_failures));
   std::printf("job stages, thread-seconds (ns per voxel):");
   for (std::size_t i = 0; i < job.stage_seconds.size(); ++i)

@@ -39,10 +39,13 @@ bool crosses_knot_lines(const spline::Surface& s, const spline::Surface& r);
 enum class SubregionMethod {
   compose,    ///< exact composition; refused where the region crosses knot lines of s
   fit,        ///< least-squares fit with pinned boundaries (seed 000 Sec. 4.3)
-  automatic,  ///< compose where possible, else fit
+  automatic,  ///< compose where possible, else fit; fillet_faces tries `matched` first
+  /// fillet_faces: B-spline faces whose knot lines C crosses, as matched Bezier pairs composed
+  /// exactly (seed 000 Alg. 4-5, fillet/matched.hpp); subregion() treats it as compose
+  matched,
 };
 
-/// "compose", "fit", "auto".
+/// "compose", "fit", "auto", "matched".
 const char* subregion_method_name(SubregionMethod m) noexcept;
 /// The method called `name`, or false.
 bool subregion_method_from_name(const char* name, SubregionMethod& out) noexcept;

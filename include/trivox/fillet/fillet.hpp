@@ -10,12 +10,21 @@
 /// blended properties (Alg. 2, Sec. 7.1, fillet/ruled_fillet.hpp). S_b interpolates the
 /// sub-regions' boundary curves on the rails, so the fillet's faces meet each other exactly.
 ///
-/// Quality (per fillet): the positional gap between the fillet's faces on S_i and S_i (closest
-/// points), the largest angle between the tangent planes of S_b and of S_i along the rails (G1),
-/// the range of det J at interior points (its sign), and the largest jump of the properties
-/// between the fillet's face on S_i and S_i at the same point.
-/// Cost: one surface intersection, two rails, two compositions or fits, one blend; the report
-/// samples a few thousand points.
+/// Construction (FilletOptions::construction): `ruled`, the ruled volume of Alg. 2 in two cells
+/// (fillet/ruled_fillet.hpp), `vbs`, the volumetric Boolean sum of Sec. 3.2 / Alg. 3 with
+/// Appendix A's division, three cells without collapsed faces (fillet/vbs_fillet.hpp), or
+/// `vrep`, the half volumetric Boolean sum of Sec. 5 / Alg. 6, one trimmed cell
+/// (fillet/vrep_fillet.hpp). All take the same S^_1, S^_2, S_b and fill the same region.
+///
+/// Quality (per fillet, either construction): the positional gap between the cells' faces on
+/// S_i and S_i, and on S_b and S_b (closest points), the largest angle between the tangent planes
+/// of the cells' faces on S_b and of S_i along the rails (G1), the range of det J at interior
+/// sample points of every cell (its sign: sampled, not bounded), the C0 glue (largest distance
+/// between the cells' shared faces at samples), and the largest jump of the properties between
+/// the cells' faces on S_i and S_i at the same point.
+/// Cost: one surface intersection, two rails, two compositions or fits, one blend, one ruled or
+/// VBS construction; the report samples a few thousand points on faces and, for det J, 36 or 24
+/// points per knot span along C and cell.
 #pragma once
 #include <array>
 #include <string>
@@ -23,10 +32,23 @@
 
 #include "trivox/fillet/blend_surface.hpp"
 #include "trivox/fillet/compose.hpp"
+#include "trivox/fillet/vbs_fillet.hpp"
+#include "trivox/fillet/vrep_fillet.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/spline/tensor_spline.hpp"
 
 namespace trivox::fillet {
+
+/// How the fillet volume is built from S^_1, S^_2 and S_b.
+enum class Construction {
+  ruled,  ///< Alg. 2: T = (1 - w) S^_12 + w S_b, two cells (the halves on S^_1 and S^_2)
+  vbs,    ///< Sec. 3.2, Alg. 3, Appendix A: three volumetric Boolean sums T_1 (at C), T_2, T_3 (at the rails)
+  vrep,   ///< Sec. 5, Alg. 6: the half volumetric Boolean sum T_hbs trimmed by S^_1, S^_2, S_b (+ caps): one V-cell
+};
+/// "ruled", "vbs", "vrep".
+const char* construction_name(Construction c) noexcept;
+/// Parses a construction_name; false (out unchanged) for anything else.
+bool construction_from_name(const char* name, Construction& out) noexcept;
 
 struct FilletOptions {
   std::array<double, 2> distance{1.0, 1.0};  ///< d_1 on S_1, d_2 on S_2 (model units), > 0
@@ -36,6 +58,9 @@ struct FilletOptions {
   /// Absolute tolerance (model units) of intersection points, rails and fits; <= 0: 1e-7 of the
   /// diagonal of the two cells' bounding box.
   double tolerance = 0.0;
+  Construction construction = Construction::ruled;
+  VbsOptions vbs;  ///< Appendix A's ratio rho and the join tolerance, for Construction::vbs
+  VrepOptions vrep;  ///< the join tolerance, for Construction::vrep
 };
 
 /// Orders and control-point counts, as seed 000 Table 1 lists them.
@@ -44,21 +69,44 @@ struct SplineShape {
 };
 
 struct FilletQuality {
-  std::array<double, 2> gap{0.0, 0.0};        ///< max distance fillet face on S_i to S_i
-  std::array<double, 2> g1_angle{0.0, 0.0};   ///< max angle (rad) of S_b to S_i's tangent plane on rail i
-  double det_min = 0.0, det_max = 0.0;        ///< det J over interior sample points of both halves
+  Construction construction = Construction::ruled;
+  std::array<double, 2> gap{0.0, 0.0};        ///< max distance from the cells' faces on S^_i to S_i
+  double blend_gap = 0.0;                     ///< max distance from the cells' faces on S_b to S_b
+  std::array<double, 2> g1_angle{0.0, 0.0};   ///< max angle (rad) of the cells' S_b faces to S_i's tangent plane on rail i
+  double det_min = 0.0, det_max = 0.0;        ///< det J over interior sample points of all cells
+  std::vector<std::array<double, 2>> cell_jacobian;  ///< per cell (Fillet::cells order): sampled det J min, max
+  /// per cell: |int det J|, exact to rounding (by the divergence theorem, over the six faces);
+  /// vrep: the trimmed cell's, |T_hbs| - |W_1| - |W_2| (VrepReport has the parts)
+  std::vector<double> cell_volume;
+  /// C0 glue: max xyz distance between the cells' shared faces at samples (ruled: the halves'
+  /// faces from C to S_b(u, 1/2); vbs: D_1, D_2, D_b). 0 when they share control points.
+  double glue = 0.0;
   std::array<double, 2> property_jump{0.0, 0.0};  ///< max |g_fillet - g_i| on S^_i (0 without properties)
   std::array<bool, 2> composed{false, false}; ///< S^_i by exact composition (else fitted)
   std::array<double, 2> rail_error{0.0, 0.0}; ///< rails: largest deviation from the exact offset
-  SplineShape face[2], sub[2], blend, fillet; ///< S_1, S_2, S^_1, S^_2, S_b, one half of T
+  SplineShape face[2], sub[2], blend, fillet; ///< S_1, S_2, S^_1, S^_2, S_b, the first cell
+  std::vector<SplineShape> cells;             ///< every cell, in Fillet::cells order
+  VbsReport vbs;                              ///< Construction::vbs: Appendix A's division
+  VrepReport vrep;                            ///< Construction::vrep: the trimming solid, caps, containment
   double seconds = 0.0;                       ///< time to build this fillet
   /// "positive", "negative" (never after orientation) or "changes sign".
   std::string jacobian() const;
 };
 
 struct Fillet {
-  std::array<spline::Trivariate, 2> halves;  ///< the fillet (ruled_fillet.hpp), in R^k
+  /// The fillet's cells, in R^k: ruled {a on S^_1, b on S^_2} (ruled_fillet.hpp); vbs
+  /// {T_1 at C, T_2 at rail 1, T_3 at rail 2} (vbs_fillet.hpp); vrep {T_hbs}, trimmed
+  /// (vrep_fillet.hpp).
+  std::vector<spline::Trivariate> cells;
+  /// vrep only: cells[0]'s trimming (Alg. 6): the solid {W_1, W_2} beyond S_b and the caps'
+  /// trimming curves (VrepFillet); empty for the other constructions.
+  std::vector<spline::Trivariate> beyond;
+  std::vector<vmodel::FaceTrim> caps;
   FilletQuality quality;
+
+  /// Cell c as a V-model cell called `name`: plain, or for vrep the trimmed V-cell
+  /// (VrepFillet::cell: T_hbs without {W_1, W_2}).
+  vmodel::VCell vcell(std::size_t c, const std::string& name) const;
 };
 
 /// The outward sign of a cell's face: +1 when the face's S_u x S_v points out of the cell.

@@ -92,10 +92,10 @@ struct VbsReport {
 ///               rails, where they become g_i)
 /// @return {T_1 at C, T_2 at rail 1, T_3 at rail 2}, each in R^k on [0, 1]^3 (see the file
 ///         comment for their faces)
-/// @throws Error (bad_input) for the inputs ruled_fillet refuses, a ratio outside (0, 1),
-///         boundaries apart by more than the tolerance, or a division that leaves the fillet
-///         (a projection parameter v_b, v_i at the end of its range); Error (failed) when the
-///         three cells' det J at their centres disagree in sign (the division folds)
+/// @throws Error (bad_input) for the inputs ruled_fillet refuses, a ratio outside (0, 1), or
+///         boundaries apart by more than the tolerance; Error (failed) for a division that leaves
+///         the fillet (a projection parameter v_b, v_i at the end of its range: a folded section)
+///         or when the three cells' det J at their centres disagree in sign (the division folds)
 std::array<spline::Trivariate, 3> vbs_fillet(const spline::Surface& sub1, const spline::Surface& sub2,
                                              const spline::Surface& blend, const VbsOptions& options = {},
                                              VbsReport* report = nullptr);

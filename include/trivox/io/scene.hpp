@@ -20,14 +20,22 @@
 /// {"op": "fillet", "between": [A, B], "distance": d | [d1, d2], "tau", "section": "hermite" |
 /// "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric" | "shepard",
 /// "power": q (Shepard only, 1..16, default 2; fillet/shepard.hpp, seed 000 Sec. 7.2), "flip": bool |
-/// [bool, bool], "name"}, A and B cell names or {"cell": NAME, "face": "u0".."w1"}; without
-/// faces, the one pair of faces that intersects is used. With "bridge": true (and both faces
-/// named) the fillet is a flend between disjoint faces instead (fillet/bridge.hpp, seed 002
-/// Sec. III): one cell `<name>.1` from face to face, with "dip". The fillet's cells, two per
-/// intersection component (`<name>.<k>a`, `<name>.<k>b`), are appended to the model; the
-/// filleted cells stay as they are. The constructors are later work: build_scene refuses them,
-/// naming them ("not supported yet"). An unknown name is refused by the reader, which lists the
-/// known ones.
+/// [bool, bool], "construction": "ruled" | "vbs" | "vrep", "name"}, A and B cell names or {"cell": NAME,
+/// "face": "u0".."w1"}; without faces, the one pair of faces that intersects is used. With
+/// "bridge": true (and both faces named) the fillet is a flend between disjoint faces instead
+/// (fillet/bridge.hpp, seed 002 Sec. III): one cell `<name>.1` from face to face, with "dip".
+/// The fillet's cells, two per intersection component (`<name>.<k>a`, `<name>.<k>b`; with
+/// "construction": "vbs", seed 000 Sec. 3.2 / Alg. 3, three: `<name>.<k>.1` at C, `.2` at
+/// rail 1, `.3` at rail 2; with "vrep", Sec. 5 / Alg. 6, one trimmed cell `<name>.<k>`, the
+/// half volumetric Boolean sum without the solid beyond S_b (fillet/vrep_fillet.hpp); vbs and
+/// vrep are refused with the Shepard blend), are appended to the model; the
+/// filleted cells stay as they are. Constructors (seed 003 Sec. 3.2.2, construct/constructors.hpp)
+/// build cells from scene surfaces: {"op": "ruled" | "boolean_sum" | "half_boolean_sum" |
+/// "extrude" | "sweep", "surfaces": [NAME, ...], "name", "field", ...}, or {"op": "boolean_sum",
+/// "tube": NAME, "core"} for the five cells inside a tube (construct/tube_solid.hpp); scene
+/// surfaces may be G+Smo patches merged ({"name", "gismo": FILE, "patches", "scale", "u", "v"})
+/// or offsets ({"name", "offset": {"surface", "distance", "tolerance"}}). `revolve` is refused
+/// ("not supported yet"). An unknown name is refused by the reader, which lists the known ones.
 ///
 /// Cost: linear in the file size to read; building is the primitives' cost (milliseconds each)
 /// plus any field refinement.
@@ -40,6 +48,7 @@
 #include <variant>
 #include <vector>
 
+#include "trivox/construct/patches.hpp"
 #include "trivox/construct/primitives.hpp"
 #include "trivox/fillet/bridge.hpp"
 #include "trivox/fillet/fillet.hpp"
@@ -65,6 +74,36 @@ struct SceneCell {
   std::variant<spline::Trivariate, ScenePrimitive> content;
 };
 
+/// A scene surface made from other surfaces instead of given as a spline (see
+/// docs/model-format.md, "Scene surfaces"): G+Smo patches merged into one surface
+/// (construct/patches.hpp; loaded with the scene), or the offset of an earlier scene surface
+/// (computed by build_scene). These feed the constructors; they are not written to the model.
+struct SceneSurfaceRecipe {
+  std::string name;
+  std::string pointer;                    ///< "/surfaces/<i>", for messages
+  std::optional<spline::Surface> merged;  ///< "gismo": the merged, scaled (and restricted) patches
+  std::string file;                       ///< "gismo": the G+Smo file as the scene names it
+  std::vector<int> patches;               ///< "gismo": the patch indices, row after row
+  std::array<int, 2> grid{0, 0};          ///< "gismo": columns (along u), rows (along v)
+  double max_gap = 0.0;                   ///< "gismo": the largest gap between shared edges
+  std::string of;                         ///< "offset": the surface offset
+  double distance = 0.0;                  ///< "offset": along S_u x S_v (model units)
+  construct::OffsetOptions offset;        ///< "offset": tolerance
+};
+
+/// The fields of a constructor operation (ruled, boolean_sum, half_boolean_sum, extrude, sweep).
+struct SceneConstructor {
+  std::vector<std::string> surfaces;      ///< the input surfaces' names, in the op's order
+  std::string tube;                       ///< boolean_sum: the tube whose solid is built (5 cells)
+  double core = 0.5;                      ///< boolean_sum of a tube: the core's relative size
+  std::optional<construct::Field> field;  ///< the cells' properties (absent: the surfaces' own)
+  int ruling_order = 2;                   ///< ruled
+  std::vector<double> vector;             ///< extrude
+  std::vector<double> params;             ///< sweep (empty: chord length)
+  int order = 4;                          ///< sweep
+  double tolerance = 1e-9;                ///< how far boundaries that must meet may be apart
+};
+
 struct SceneOperation {
   std::string op;
   std::string pointer;  ///< "/operations/<i>"
@@ -81,6 +120,7 @@ struct SceneOperation {
   bool bridge = false;      ///< "bridge": true: a flend between disjoint faces (fillet/bridge.hpp)
   bool shepard = false;     ///< "blend": "shepard" (seed 000 Sec. 7.2), else parametric (Sec. 7.1)
   int shepard_power = 2;    ///< "power": Shepard's q, 1..16
+  SceneConstructor constructor;  ///< constructors: their inputs (the result is `name`)
 };
 
 struct Scene {
@@ -89,6 +129,7 @@ struct Scene {
   std::vector<std::string> properties;
   std::vector<SceneCell> cells;
   std::vector<vmodel::NamedSurface> surfaces;
+  std::vector<SceneSurfaceRecipe> derived_surfaces;  ///< "gismo" and "offset" surfaces, in file order
   std::vector<SceneOperation> operations;
 };
 
@@ -119,7 +160,8 @@ struct FilletBuild {
   std::string pointer;   ///< "/operations/<i>"
   std::array<std::string, 2> cells;  ///< the filleted cells
   std::array<spline::Face, 2> faces{};
-  std::vector<std::array<std::string, 2>> cell_names;  ///< per component: its two cells in the model
+  /// per component: its cells in the model (ruled: a, b; vbs: T_1, T_2, T_3; vrep: the trimmed T_hbs)
+  std::vector<std::vector<std::string>> cell_names;
   std::vector<fillet::FilletQuality> quality;          ///< per component
   /// "blend": "shepard": the encoding's fit of f per cell (two per component, a then b).
   struct ShepardFit {
@@ -141,8 +183,29 @@ struct BridgeBuild {
   double seconds = 0.0;
 };
 
+/// What one derived surface gave ("gismo" or "offset").
+struct SurfaceBuild {
+  std::string name, kind;
+  std::array<int, 2> orders{}, counts{};
+  double max_gap = 0.0;        ///< gismo: largest gap between shared patch edges
+  double distance = 0.0;       ///< offset
+  construct::OffsetReport offset;
+  double seconds = 0.0;
+};
+
+/// What one constructor operation gave: its cells.
+struct ConstructBuild {
+  std::string name, op, pointer;
+  std::vector<std::string> cells;  ///< the cells in the model: `name`, or `name.core`, `name.s0`..
+  bool has_field = false;
+  construct::FieldReport field;
+  double seconds = 0.0;
+};
+
 struct SceneBuild {
   vmodel::VModel model;
+  std::vector<SurfaceBuild> surfaces;
+  std::vector<ConstructBuild> constructs;
   std::vector<PrimitiveBuild> primitives;
   std::vector<FilletBuild> fillets;
   std::vector<BridgeBuild> bridges;
