@@ -2,6 +2,7 @@
 // parameters, sub-regions and the input of the blending surface. Shared by test_fillet_parts.cpp,
 // test_vbs_fillet.cpp and test_vrep_fillet.cpp; also the Hermite section's area.
 #pragma once
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -37,6 +38,16 @@ using trivox::spline::KnotVector;
 using trivox::spline::Surface;
 namespace fillet = trivox::fillet;
 namespace spline = trivox::spline;
+
+/// A trilinear box cell [lo, hi] with one property value.
+inline trivox::spline::Trivariate box_cell(std::array<double, 3> lo, std::array<double, 3> hi, double value) {
+  std::vector<double> pts;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) pts.insert(pts.end(), {i ? hi[0] : lo[0], j ? hi[1] : lo[1], k ? hi[2] : lo[2], value});
+  const auto kv = KnotVector::bezier(2);
+  return trivox::spline::Trivariate({kv, kv, kv}, 4, pts);
+}
 
 /// A bilinear patch through four corners (u fastest), in R^dim.
 inline Surface patch(const std::vector<double>& c00, const std::vector<double>& c10, const std::vector<double>& c01,

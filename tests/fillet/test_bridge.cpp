@@ -13,23 +13,14 @@
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/spline/extract.hpp"
 
+#include "corner.hpp"
+
 using namespace trivox;
 using spline::Face;
 using spline::Trivariate;
+const auto box = fillet_test::box_cell;  // tests/fillet/corner.hpp
 
 namespace {
-
-/// A trilinear box cell [lo, hi] with one property value.
-Trivariate box(std::array<double, 3> lo, std::array<double, 3> hi, double value) {
-  std::vector<double> pts;
-  for (int k = 0; k < 2; ++k)
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) {
-        pts.insert(pts.end(), {i ? hi[0] : lo[0], j ? hi[1] : lo[1], k ? hi[2] : lo[2], value});
-      }
-  const auto kv = spline::KnotVector::bezier(2);
-  return Trivariate({kv, kv, kv}, 4, pts);
-}
 
 double angle_to(const Trivariate& t, double u, double v, double w, std::array<double, 3> dir) {
   const auto d = t.eval_derivatives({u, v, w}, 1);

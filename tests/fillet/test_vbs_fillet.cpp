@@ -27,6 +27,7 @@
 #include "trivox/spline/extract.hpp"
 
 using namespace trivox;
+using fillet_test::box_cell;
 using fillet_test::Corner;
 using fillet_test::patch;
 using spline::Face;
@@ -381,20 +382,6 @@ TEST_CASE("VBS fillet refuses bad options and boundaries apart", "[fillet][vbs]"
   const Surface two = spline::coordinates(s2, 0, 2);
   CHECK_THROWS_AS(fillet::vbs_fillet(s1, two, b), Error);
 }
-
-namespace {
-
-/// A trilinear box cell [lo, hi] with one property value.
-Trivariate box_cell(std::array<double, 3> lo, std::array<double, 3> hi, double value) {
-  std::vector<double> pts;
-  for (int k = 0; k < 2; ++k)
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) pts.insert(pts.end(), {i ? hi[0] : lo[0], j ? hi[1] : lo[1], k ? hi[2] : lo[2], value});
-  const auto kv = spline::KnotVector::bezier(2);
-  return Trivariate({kv, kv, kv}, 4, pts);
-}
-
-}  // namespace
 
 TEST_CASE("fillet_faces, ruled and vbs: the quality report of each construction", "[fillet][vbs]") {
   // Floor [0,4]^2 x [-1,0] (property 10), wall [1,2] x [-0.5,4.5] x [-0.5,3] (property 20):

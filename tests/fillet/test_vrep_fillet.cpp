@@ -28,21 +28,13 @@
 #include "trivox/spline/extract.hpp"
 
 using namespace trivox;
+using fillet_test::box_cell;
 using fillet_test::Corner;
 using spline::Face;
 using spline::Surface;
 using spline::Trivariate;
 
 namespace {
-
-Trivariate box_cell(std::array<double, 3> lo, std::array<double, 3> hi, double value) {
-  std::vector<double> pts;
-  for (int k = 0; k < 2; ++k)
-    for (int j = 0; j < 2; ++j)
-      for (int i = 0; i < 2; ++i) pts.insert(pts.end(), {i ? hi[0] : lo[0], j ? hi[1] : lo[1], k ? hi[2] : lo[2], value});
-  const auto kv = spline::KnotVector::bezier(2);
-  return Trivariate({kv, kv, kv}, 4, pts);
-}
 
 vmodel::VModel model_of(std::vector<vmodel::VCell> cells) {
   vmodel::VModel m;
