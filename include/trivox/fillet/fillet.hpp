@@ -53,6 +53,7 @@ bool construction_from_name(const char* name, Construction& out) noexcept;
 struct FilletOptions {
   std::array<double, 2> distance{1.0, 1.0};  ///< d_1 on S_1, d_2 on S_2 (model units), > 0
   BlendOptions blend;                        ///< section, tau, dip, angle tolerance
+  /// Sub-regions: compose, fit, matched (Alg. 4-5) or automatic (compose, else matched, else fit)
   SubregionMethod method = SubregionMethod::automatic;
   std::array<bool, 2> flip{false, false};    ///< rail i on the other side of C
   /// Absolute tolerance (model units) of intersection points, rails and fits; <= 0: 1e-7 of the
@@ -112,7 +113,9 @@ struct Fillet {
 /// The outward sign of a cell's face: +1 when the face's S_u x S_v points out of the cell.
 double outward_sign(const spline::Trivariate& cell, spline::Face face);
 
-/// The fillets between face f1 of cell1 and face f2 of cell2, one per intersection component.
+/// The fillets between face f1 of cell1 and face f2 of cell2, one per intersection component, or
+/// with matched Bezier pairs (SubregionMethod::matched, or automatic on B-spline faces where
+/// Lemma 1 holds; fillet/matched.hpp, seed 000 Alg. 4-5) one per piece, in order along C.
 /// @throws Error (bad_input) for cells of different dimensions, faces that do not intersect
 ///         ("... do not intersect"), an intersection that is only a point, distances or
 ///         parameters out of range or rails leaving their face (the message names the face);
