@@ -643,7 +643,7 @@ SceneBuild build_scene(const Scene& scene) {
     if (boolean || op.op == "fillet" || scene_detail::is_constructor(op.op)) continue;
     src.fail(op.pointer + "/op",
              quote(op.op) + " is not supported yet in scenes (`trivox construct` runs it on its own); expected "
-                 "union, intersection, subtraction, fillet, ruled, boolean_sum, half_boolean_sum, extrude or sweep");
+                 "union, intersection, subtraction, fillet, ruled, boolean_sum, half_boolean_sum, extrude, revolve or sweep");
   }
   SceneBuild out;
   out.model.units = scene.units;

@@ -3,6 +3,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <numbers>
 
 #include "trivox/construct/constructors.hpp"
 #include "trivox/construct/tube_solid.hpp"
@@ -18,7 +19,7 @@ using spline::Surface;
 
 namespace {
 
-constexpr const char* constructor_ops[] = {"ruled", "boolean_sum", "half_boolean_sum", "extrude", "sweep"};
+constexpr const char* constructor_ops[] = {"ruled", "boolean_sum", "half_boolean_sum", "extrude", "revolve", "sweep"};
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -216,7 +217,7 @@ void read_constructor(const Source& src, const json& item, const std::string& ip
     if (o.op == "ruled") lo = hi = 2, count = "2 surfaces [bottom, top]";
     if (o.op == "boolean_sum") lo = hi = 6, count = "6 surfaces [u0, u1, v0, v1, w0, w1] (or \"tube\": NAME)";
     if (o.op == "half_boolean_sum") lo = 2, hi = 3, count = "2 or 3 surfaces";
-    if (o.op == "extrude") lo = hi = 1, count = "1 surface";
+    if (o.op == "extrude" || o.op == "revolve") lo = hi = 1, count = "1 surface";
     if (o.op == "sweep") lo = 2, hi = 1 << 20, count = "2 or more sections";
     const json& s = require(src, item, ip, "surfaces", what);
     if (!s.is_array()) fail_type(src, sp, s, "an array of " + count);
@@ -248,6 +249,34 @@ void read_constructor(const Source& src, const json& item, const std::string& ip
     if (c.vector[0] == 0.0 && c.vector[1] == 0.0 && c.vector[2] == 0.0)
       src.fail(vp, "the zero vector; expected a non-zero extrusion vector");
   }
+  if (o.op == "revolve") {
+    // The keys of `trivox construct`'s revolve (docs/cli.md): axis, origin, angle in degrees,
+    // tolerance relative to the largest distance from the axis.
+    const std::string what_r = "a revolution {\"surfaces\": [NAME], \"axis\": [x, y, z], \"origin\", \"angle\", \"tolerance\"}";
+    auto vec3 = [&](const char* key, const std::string& expected) {
+      const std::string vp = child(ip, key);
+      const json& v = require(src, item, ip, key, what_r);
+      if (!v.is_array() || v.size() != 3) fail_type(src, vp, v, expected);
+      const auto x = read_numbers(src, v, vp, expected);
+      return std::array<double, 3>{x[0], x[1], x[2]};
+    };
+    c.revolution.axis = vec3("axis", "the axis direction [x, y, z]");
+    if (c.revolution.axis == std::array<double, 3>{0.0, 0.0, 0.0})
+      src.fail(child(ip, "axis"), "the zero vector; expected a non-zero axis direction");
+    if (item.contains("origin")) c.revolution.origin = vec3("origin", "a point on the axis [x, y, z]");
+    if (const json* a = find(item, "angle")) {
+      const double deg = read_number(src, *a, child(ip, "angle"));
+      if (!(deg > 0.0 && deg <= 360.0))
+        src.fail(child(ip, "angle"), "angle " + format_double(deg) + "; expected degrees in (0, 360]");
+      c.revolution.angle = deg == 360.0 ? 2.0 * std::numbers::pi : deg * std::numbers::pi / 180.0;
+    }
+    if (const json* t = find(item, "tolerance")) {
+      c.revolution.relative_tolerance = read_number(src, *t, child(ip, "tolerance"));
+      if (!(c.revolution.relative_tolerance >= 1e-12))
+        src.fail(child(ip, "tolerance"), "tolerance " + format_double(c.revolution.relative_tolerance) +
+                                             "; expected a relative tolerance >= 1e-12");
+    }
+  }
   if (o.op == "sweep") {
     if (const json* p = find(item, "params")) {
       const std::string pp = child(ip, "params");
@@ -262,7 +291,7 @@ void read_constructor(const Source& src, const json& item, const std::string& ip
     }
     if (const json* t = find(item, "order")) c.order = read_int(src, *t, child(ip, "order"), 2, 10, "an order in 2..10");
   }
-  if (const json* t = find(item, "tolerance")) {
+  if (const json* t = find(item, "tolerance"); t && o.op != "revolve") {
     c.tolerance = read_number(src, *t, child(ip, "tolerance"));
     if (!(c.tolerance > 0.0)) src.fail(child(ip, "tolerance"), "tolerance " + format_double(c.tolerance) + "; expected > 0");
   }
@@ -340,6 +369,8 @@ std::vector<vmodel::VCell> apply_constructor(const Scene& scene, const Source& s
                                                : construct::half_boolean_sum(in[0], in[1], in[2], match)});
     } else if (op.op == "extrude") {
       cells.push_back({op.name, construct::extrude(in[0], c.vector)});
+    } else if (op.op == "revolve") {
+      cells.push_back({op.name, construct::revolve(in[0], c.revolution)});  // seed 003 Sec. 3.2.2 item 3
     } else {
       cells.push_back({op.name, construct::sweep(in, c.params, c.order)});
     }

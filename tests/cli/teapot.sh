@@ -98,5 +98,5 @@ bad name 's["operations"][0]["surfaces"][1] = "nope"' "/operations/0/surfaces/1:
 bad nofield 'del s["operations"][0]["field"]' "/operations/0: missing \"field\""
 bad core 's["operations"][0] = {"op": "boolean_sum", "name": "b", "tube": "body_out", "core": 2}' "/operations/0/core: core 2"
 bad tube 's["operations"][0] = {"op": "boolean_sum", "name": "b", "tube": "body_in", "surfaces": []}' "/operations/0/tube: both"
-bad revolve 's["operations"][0]["op"] = "revolve"' "/operations/0/op: \"revolve\" is not supported yet"
+bad revolve 's["operations"][0] = {"op": "revolve", "name": "r", "surfaces": ["body_out"], "axis": [0, 0, 0]}' "/operations/0/axis: the zero vector"
 echo "teapot: ok"

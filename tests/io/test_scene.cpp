@@ -126,12 +126,10 @@ TEST_CASE("scene: malformed scenes name the file, the place and what was expecte
                  "\"subtraction\", \"fillet\", \"ruled\", \"extrude\", \"revolve\", \"boolean_sum\", \"half_boolean_sum\", \"sweep\""});
 }
 
-TEST_CASE("scene: revolve is not built yet, the other constructors need a name; expanded names must stay unique", "[scene]") {
+TEST_CASE("scene: the constructors need a name; expanded names must stay unique", "[scene]") {
   // union, intersection, subtraction (tests/cli/booleans.sh), fillet (tests/cli/fillet.sh) and the
-  // constructors but revolve (below; tests/cli/teapot.sh) are built.
-  check_message(build_error(scene(ball, R"({"op": "revolve"})")),
-                {"s.json: /operations/0/op: \"revolve\" is not supported yet", "expected"});
-  for (const char* op : {"ruled", "extrude", "boolean_sum", "half_boolean_sum", "sweep"}) {
+  // constructors (tests/cli/teapot.sh, tests/cli/build.sh) are built.
+  for (const char* op : {"ruled", "extrude", "revolve", "boolean_sum", "half_boolean_sum", "sweep"}) {
     INFO(op);
     check_message(build_error(scene(ball, std::string(R"({"op": ")") + op + "\"}")),
                   {"s.json: /operations/0: missing \"name\"", "expected"});

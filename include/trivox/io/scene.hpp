@@ -31,11 +31,12 @@
 /// vrep are refused with the Shepard blend), are appended to the model; the
 /// filleted cells stay as they are. Constructors (seed 003 Sec. 3.2.2, construct/constructors.hpp)
 /// build cells from scene surfaces: {"op": "ruled" | "boolean_sum" | "half_boolean_sum" |
-/// "extrude" | "sweep", "surfaces": [NAME, ...], "name", "field", ...}, or {"op": "boolean_sum",
+/// "extrude" | "revolve" | "sweep", "surfaces": [NAME, ...], "name", "field", ...} (revolve: "axis",
+/// "origin", "angle" in degrees, "tolerance" as `trivox construct`), or {"op": "boolean_sum",
 /// "tube": NAME, "core"} for the five cells inside a tube (construct/tube_solid.hpp); scene
 /// surfaces may be G+Smo patches merged ({"name", "gismo": FILE, "patches", "scale", "u", "v"})
-/// or offsets ({"name", "offset": {"surface", "distance", "tolerance"}}). `revolve` is refused
-/// ("not supported yet"). An unknown name is refused by the reader, which lists the known ones.
+/// or offsets ({"name", "offset": {"surface", "distance", "tolerance"}}). An unknown name is
+/// refused by the reader, which lists the known ones.
 ///
 /// Cost: linear in the file size to read; building is the primitives' cost (milliseconds each)
 /// plus any field refinement.
@@ -49,6 +50,7 @@
 #include <vector>
 
 #include "trivox/construct/patches.hpp"
+#include "trivox/construct/constructors.hpp"
 #include "trivox/construct/primitives.hpp"
 #include "trivox/fillet/bridge.hpp"
 #include "trivox/fillet/fillet.hpp"
@@ -91,7 +93,8 @@ struct SceneSurfaceRecipe {
   construct::OffsetOptions offset;        ///< "offset": tolerance
 };
 
-/// The fields of a constructor operation (ruled, boolean_sum, half_boolean_sum, extrude, sweep).
+/// The fields of a constructor operation (ruled, boolean_sum, half_boolean_sum, extrude, revolve,
+/// sweep).
 struct SceneConstructor {
   std::vector<std::string> surfaces;      ///< the input surfaces' names, in the op's order
   std::string tube;                       ///< boolean_sum: the tube whose solid is built (5 cells)
@@ -99,6 +102,7 @@ struct SceneConstructor {
   std::optional<construct::Field> field;  ///< the cells' properties (absent: the surfaces' own)
   int ruling_order = 2;                   ///< ruled
   std::vector<double> vector;             ///< extrude
+  construct::Revolution revolution;       ///< revolve: axis, origin, angle, relative tolerance
   std::vector<double> params;             ///< sweep (empty: chord length)
   int order = 4;                          ///< sweep
   double tolerance = 1e-9;                ///< how far boundaries that must meet may be apart
