@@ -338,7 +338,7 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
     ro.flip = o.flip;
     const RailPair rp = offset_rails(s1, s2, outward, curve, o.distance, ro);
     SubregionOptions so;
-    so.method = o.method == SubregionMethod::matched ? SubregionMethod::compose : o.method;
+    so.method = o.method;  // subregion() composes for `matched` (only the whole curve lands there)
     so.tolerance = tol;
     // The sub-regions and blending inputs: one pair over the whole curve, or, for B-spline faces
     // whose knot lines C crosses, one matched Bezier pair per piece (seed 000 Alg. 4-5), each
@@ -348,7 +348,7 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
       BlendInput in;
       std::array<bool, 2> composed{};
     };
-    const auto fitted_part = [&]() {
+    const auto whole_part = [&]() {  // composed, or fitted (Sec. 4.3)
       SubregionReport r1, r2;
       Part pt;
       pt.sub1 = subregion(s1, rp.rails[0].rail, rp.rails[0].base, so, &r1);
@@ -399,10 +399,7 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
     if (o.method == SubregionMethod::matched || (o.method == SubregionMethod::automatic && crossing)) {
       try {
         for (auto& mp : matched_pieces(s1, s2, rp, matched_cuts(s1, s2, rp))) {
-          Part pt{std::move(mp.sub1), std::move(mp.sub2), mp.blend, {true, true}};
-          pt.in.rail = {spline::iso(pt.sub1, 1, 0.0), spline::iso(pt.sub2, 1, 1.0)};
-          pt.in.center = spline::iso(pt.sub1, 1, 1.0);
-          made.push_back(make(pt));
+          made.push_back(make(Part{std::move(mp.sub1), std::move(mp.sub2), std::move(mp.blend), {true, true}}));
         }
       } catch (const Error& e) {
         // Lemma 1's condition, or a piece's blend, fails: "auto" fits instead (Sec. 4.3).
@@ -410,7 +407,7 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
         made.clear();
       }
     }
-    if (made.empty()) made.push_back(make(fitted_part()));
+    if (made.empty()) made.push_back(make(whole_part()));
     for (auto& f : made) out.push_back(std::move(f));
   }
   return out;

@@ -152,9 +152,24 @@ std::vector<MatchedCut> matched_cuts(const Surface& face1, const Surface& face2,
   for (int i = 0; i < 2; ++i) {
     const Rail& ri = rails.rails[static_cast<std::size_t>(i)];
     const auto ui = static_cast<std::size_t>(i);
+    // A line that C crosses several times is one cutting line for several cuts: its crossings
+    // with C and with the rail are found once.
+    struct Crossings {
+      int dir;
+      double value;
+      std::vector<double> on_c, on_r;
+    };
+    std::vector<Crossings> lines;
+    const auto crossings_of = [&](int dir, double value) -> const Crossings& {
+      for (const auto& l : lines)
+        if (l.dir == dir && l.value == value) return l;
+      lines.push_back({dir, value, level_crossings(ri.base, dir, value), level_crossings(ri.rail, dir, value)});
+      return lines.back();
+    };
     for (auto& cut : merged) {
-      const auto on_c = level_crossings(ri.base, cut.dir[ui], cut.value[ui]);
-      const auto on_r = level_crossings(ri.rail, cut.dir[ui], cut.value[ui]);
+      const Crossings& x = crossings_of(cut.dir[ui], cut.value[ui]);
+      const auto& on_c = x.on_c;
+      const auto& on_r = x.on_r;
       const std::string line = std::string(cut.dir[ui] == 0 ? "u = " : "v = ") + num(cut.value[ui]);
       if (on_c.size() != on_r.size())
         throw Error("fillet (seed 000 Alg. 5): face " + std::to_string(i + 1) + "'s cutting line " + line + " crosses C " +

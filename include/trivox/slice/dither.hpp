@@ -22,10 +22,11 @@
 /// diffusion carries its state across calls, so the output does not depend on how a layer is
 /// split into bands. Rows skipped between two calls count as void rows.
 ///
-/// Cost: O(materials) per non-void voxel (about 8 flops per material for `fs`, in 4-wide vectors (8-wide with AVX2 for the colour path)
-/// up to 8 materials; dither_paint maps, dithers and paints in one pass), O(1) per void voxel; no allocation after construction; memory for `fs`
-/// 2 (nx + 2) s floats, s = materials (rounded up to a multiple of 4 when at most 8). One LayerDitherer per thread: it holds the
-/// error state of the layer in progress.
+/// Cost: O(materials) per non-void voxel (about 8 flops per material for `fs`, in 4-wide vectors
+/// up to 8 materials, one 8-wide vector with AVX2 on the colour path; dither_paint maps, dithers
+/// and paints in one pass), O(1) per void voxel; no allocation after construction; memory for
+/// `fs` 2 (nx + 2) s floats, s = materials (rounded up to a multiple of 4 when at most 8). One
+/// LayerDitherer per thread: it holds the error state of the layer in progress.
 #pragma once
 #include <array>
 #include <cstdint>
