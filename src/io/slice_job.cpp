@@ -5,10 +5,12 @@
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <optional>
@@ -57,6 +59,10 @@ struct Scratch {
   slice::RowBand band;
   std::optional<slice::LayerDitherer> dither;  ///< its error rows, allocated once per thread
   std::vector<std::uint8_t> rgba;
+  // Grouped layers (slice::LayerGroupDitherer): a band and the pixels of each layer of a group.
+  std::optional<slice::LayerGroupDitherer> group;
+  std::vector<slice::RowBand> bands;
+  std::vector<std::vector<std::uint8_t>> rgbas;
   std::array<double, 5> seconds{};  ///< per stage, see SliceJobSummary::stage_seconds
 };
 
@@ -234,7 +240,34 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
 
   tbb::enumerable_thread_specific<Scratch> scratch;
   int done = kept;
-  const int tokens = static_cast<int>(tbb::this_task_arena::max_concurrency()) + 1;
+  const int threads = static_cast<int>(tbb::this_task_arena::max_concurrency());
+  const int tokens = threads + 1;
+
+  // Work items are groups of layers. On the colour path with fs, a group of up to 8 layers is
+  // dithered together, one layer per vector lane (slice::LayerGroupDitherer: the same pixels as
+  // one layer at a time, at a fraction of the cost), when each thread's group of pixel buffers
+  // fits in group_budget / threads; otherwise every group is one layer. The groups split the
+  // layers to do into a multiple of the thread count of nearly equal sizes, so that no thread
+  // is left with a last group alone.
+  constexpr double group_budget = 1024.0 * 1024.0 * 1024.0;  // bytes of RGBA layers in all groups
+  const double layer_bytes = static_cast<double>(nx) * static_cast<double>(ny) * 4.0;
+  // TRIVOX_LAYER_GROUP=N caps the group size (diagnostics and tests: the output is the same).
+  int group_cap = slice::LayerGroupDitherer::max_layers;
+  if (const char* env = std::getenv("TRIVOX_LAYER_GROUP"))
+    group_cap = std::clamp(std::atoi(env), 1, slice::LayerGroupDitherer::max_layers);
+  const bool grouped = group_cap >= 3 && slice::LayerGroupDitherer::serves(mode, mapper) &&
+                       group_cap * layer_bytes * threads <= group_budget;
+  std::vector<std::vector<int>> groups;
+  {
+    const int n = static_cast<int>(todo.size()), g = grouped ? group_cap : 1;
+    int ng = (n + g - 1) / g;
+    if (grouped) ng = std::min(n, (ng + threads - 1) / threads * threads);
+    for (int i = 0, at = 0; i < ng; ++i) {
+      const int size = n / ng + (i < n % ng ? 1 : 0);
+      groups.emplace_back(todo.begin() + at, todo.begin() + at + size);
+      at += size;
+    }
+  }
   std::size_t next = 0;
 
   auto sample_layer = [&](int k) {
@@ -270,29 +303,86 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     return out;
   };
 
+  // Groups of 3 or more layers take the grouped kernel (below that, the lanes it would leave
+  // empty cost more than dithering the layers one by one).
+  auto sample_group = [&](const std::vector<int>& layers) {
+    std::vector<LayerOut> outs;
+    const int n = static_cast<int>(layers.size());
+    if (!grouped || n < 3) {
+      for (int k : layers) outs.push_back(sample_layer(k));
+      return outs;
+    }
+    Scratch& s = scratch.local();
+    const auto un = static_cast<std::size_t>(n), unx = static_cast<std::size_t>(nx);
+    if (!s.group) s.group.emplace(nx, mapper, grid.pitch[0], grid.pitch[1]);
+    s.bands.resize(un);
+    s.rgbas.resize(un);
+    outs.resize(un);
+    std::vector<std::vector<std::int64_t>> counts(un, std::vector<std::int64_t>(static_cast<std::size_t>(nmat), 0));
+    const std::int32_t* cell[slice::LayerGroupDitherer::max_layers];
+    const float* props[slice::LayerGroupDitherer::max_layers];
+    std::uint8_t* rgba[slice::LayerGroupDitherer::max_layers];
+    std::int64_t* count[slice::LayerGroupDitherer::max_layers];
+    for (std::size_t i = 0; i < un; ++i) {
+      s.rgbas[i].resize(unx * static_cast<std::size_t>(ny) * 4);
+      outs[i].layer = layers[i];
+      count[i] = counts[i].data();
+    }
+    s.group->begin(n);
+    // Bands of a few sampler blocks, so that the group's bands stay in the L2 cache between the
+    // sampler writing them and the ditherer reading them.
+    const int group_rows = std::min(band_rows, 2 * slice::LayerSampler::block_rows);
+    double t = thread_cpu_seconds();
+    for (int r0 = 0; r0 < ny; r0 += group_rows) {
+      const int rows = std::min(group_rows, ny - r0);
+      for (std::size_t i = 0; i < un; ++i) {
+        sampler.sample(layers[i], r0, rows, s.bands[i]);
+        outs[i].failures += s.bands[i].failures;
+      }
+      lap(t, s.seconds[0]);
+      for (int r = 0; r < rows; ++r) {
+        const auto ur = static_cast<std::size_t>(r);
+        for (std::size_t i = 0; i < un; ++i) {
+          cell[i] = s.bands[i].cell.data() + ur * unx;
+          props[i] = s.bands[i].props.data() + ur * unx * static_cast<std::size_t>(nprops);
+          rgba[i] = s.rgbas[i].data() + (static_cast<std::size_t>(r0) + ur) * unx * 4;
+        }
+        s.group->dither_paint(r0 + r, cell, props, colour, rgba, count);
+      }
+      lap(t, s.seconds[2]);
+    }
+    for (std::size_t i = 0; i < un; ++i) {
+      outs[i].counts = counts[i];
+      outs[i].png = encode_png_rgba(s.rgbas[i].data(), nx, ny, cfg.dpi_x, cfg.dpi_y);
+      outs[i].sha256 = sha256_hex(outs[i].png);
+    }
+    lap(t, s.seconds[4]);
+    return outs;
+  };
+
   tbb::parallel_pipeline(
       static_cast<std::size_t>(tokens),
-      tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
-                                  [&](tbb::flow_control& fc) {
-                                    if (next >= todo.size()) {
-                                      fc.stop();
-                                      return 0;
-                                    }
-                                    return todo[next++];
-                                  }) &
-          tbb::make_filter<int, LayerOut>(tbb::filter_mode::parallel, sample_layer) &
-          tbb::make_filter<LayerOut, void>(tbb::filter_mode::serial_in_order, [&](LayerOut out) {
-            const std::string name = cfg.slice_name(out.layer);
-            write_file_atomically(opt.out_dir / name, out.png, Durability::deferred);
-            finished[out.layer] = ManifestLayer{out.layer, name, out.sha256, out.counts, out.failures};
-            ++done;
-            if (std::chrono::duration<double>(Clock::now() - last_manifest).count() >= opt.manifest_interval_s) {
-              write_manifest(false);
-              last_manifest = Clock::now();
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                                      [&](tbb::flow_control& fc) -> std::size_t {
+                                                        if (next >= groups.size()) fc.stop();
+                                                        return next++;
+                                                      }) &
+          tbb::make_filter<std::size_t, std::vector<LayerOut>>(
+              tbb::filter_mode::parallel, [&](std::size_t g) { return sample_group(groups[g]); }) &
+          tbb::make_filter<std::vector<LayerOut>, void>(tbb::filter_mode::serial_in_order, [&](std::vector<LayerOut> outs) {
+            for (LayerOut& out : outs) {
+              const std::string name = cfg.slice_name(out.layer);
+              write_file_atomically(opt.out_dir / name, out.png, Durability::deferred);
+              finished[out.layer] = ManifestLayer{out.layer, name, out.sha256, out.counts, out.failures};
+              ++done;
+              if (std::chrono::duration<double>(Clock::now() - last_manifest).count() >= opt.manifest_interval_s) {
+                write_manifest(false);
+                last_manifest = Clock::now();
+              }
+              if (progress)
+                progress(done, total_layers, static_cast<std::int64_t>(done) * grid.voxels_per_layer(),
+                         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
             }
-            if (progress)
-              progress(done, total_layers, static_cast<std::int64_t>(done) * grid.voxels_per_layer(),
-                       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
           }));
 
   std::vector<std::int64_t> totals(static_cast<std::size_t>(nmat), 0);

@@ -2,11 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
 #include "trivox/error.hpp"
 #include "trivox/slice/material.hpp"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
 
 namespace trivox::slice {
 
@@ -488,6 +493,246 @@ StochasticKernel stochastic_kernel_for(int materials) {
   }
 }
 
+// ------------------------------------------------------------------------------------------
+// Grouped layers (LayerGroupDitherer): one lane per layer, AVX2
+
+/// Colour materials carried per voxel by the grouped kernel, and floats of error per column.
+constexpr int group_k = 5, group_stride = group_k * 8;
+
+#ifdef TRIVOX_DITHER_AVX2
+
+/// What one grouped row needs (LayerGroupDitherer::dither_paint). Column-major buffers hold,
+/// per column, one 8-float (or int32) vector whose lane l belongs to the group's layer l.
+struct GroupRow {
+  int nx;
+  bool left_to_right;
+  const __m256 (*weights)[4];  // per neighbour-availability mask, broadcast
+  const std::int32_t* cell;    // (nx + 2) * 8: column c at (c + 1) * 8; the pads are void
+  const float* props;          // nx * np * 8: property p of column c at (c np + p) * 8
+  int np, ir, ig, ib;
+  const float* in;             // (nx + 2) * group_stride: incoming error, one pad column each side
+  float* down;                 // the same for the next row (every column and both pads stored)
+  __m256i colours;             // RGBA of materials 0..4 in lanes 0..4, lane 7 void (0 0 0 0)
+  std::int32_t* rgba;          // nx * 8: the chosen colour of column c at c * 8
+  __m256* counts;              // group_k vectors: per material, per lane, added to
+};
+
+/// 8 x 8 transposes: rows r0..r7 (8 floats each) into columns.
+[[gnu::target("avx2"), gnu::always_inline]] inline void transpose8(__m256& r0, __m256& r1, __m256& r2, __m256& r3, __m256& r4,
+                                                                   __m256& r5, __m256& r6, __m256& r7) noexcept {
+  const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+  const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+  const __m256 t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5);
+  const __m256 t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
+  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xee);
+  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xee);
+  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xee);
+  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xee);
+  r0 = _mm256_permute2f128_ps(u0, u4, 0x20), r1 = _mm256_permute2f128_ps(u1, u5, 0x20);
+  r2 = _mm256_permute2f128_ps(u2, u6, 0x20), r3 = _mm256_permute2f128_ps(u3, u7, 0x20);
+  r4 = _mm256_permute2f128_ps(u0, u4, 0x31), r5 = _mm256_permute2f128_ps(u1, u5, 0x31);
+  r6 = _mm256_permute2f128_ps(u2, u6, 0x31), r7 = _mm256_permute2f128_ps(u3, u7, 0x31);
+}
+
+/// dst[j * 8 + l] = src[l][j] for j < n (4-byte elements): eight rows into column-major lanes.
+[[gnu::target("avx2")]] void to_lanes(const void* const* src, std::size_t n, void* dst) noexcept {
+  const float* s[8];
+  for (int l = 0; l < 8; ++l) s[l] = static_cast<const float*>(src[l]);
+  float* d = static_cast<float*>(dst);
+  std::size_t j = 0;
+  for (; j + 8 <= n; j += 8) {
+    __m256 r0 = _mm256_loadu_ps(s[0] + j), r1 = _mm256_loadu_ps(s[1] + j), r2 = _mm256_loadu_ps(s[2] + j),
+           r3 = _mm256_loadu_ps(s[3] + j), r4 = _mm256_loadu_ps(s[4] + j), r5 = _mm256_loadu_ps(s[5] + j),
+           r6 = _mm256_loadu_ps(s[6] + j), r7 = _mm256_loadu_ps(s[7] + j);
+    transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
+    float* o = d + j * 8;
+    _mm256_storeu_ps(o, r0), _mm256_storeu_ps(o + 8, r1), _mm256_storeu_ps(o + 16, r2), _mm256_storeu_ps(o + 24, r3);
+    _mm256_storeu_ps(o + 32, r4), _mm256_storeu_ps(o + 40, r5), _mm256_storeu_ps(o + 48, r6), _mm256_storeu_ps(o + 56, r7);
+  }
+  for (; j < n; ++j)
+    for (int l = 0; l < 8; ++l) d[j * 8 + static_cast<std::size_t>(l)] = s[l][j];
+}
+
+/// dst[l][j] = src[j * 8 + l] for j < n and l < lanes: the inverse of to_lanes.
+[[gnu::target("avx2")]] void from_lanes(const void* src, std::size_t n, int lanes, void* const* dst) noexcept {
+  const float* s = static_cast<const float*>(src);
+  float* d[8];
+  for (int l = 0; l < 8; ++l) d[l] = static_cast<float*>(dst[l]);
+  std::size_t j = 0;
+  if (lanes == 8)
+    for (; j + 8 <= n; j += 8) {
+      const float* q = s + j * 8;
+      __m256 r0 = _mm256_loadu_ps(q), r1 = _mm256_loadu_ps(q + 8), r2 = _mm256_loadu_ps(q + 16), r3 = _mm256_loadu_ps(q + 24),
+             r4 = _mm256_loadu_ps(q + 32), r5 = _mm256_loadu_ps(q + 40), r6 = _mm256_loadu_ps(q + 48), r7 = _mm256_loadu_ps(q + 56);
+      transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
+      _mm256_storeu_ps(d[0] + j, r0), _mm256_storeu_ps(d[1] + j, r1), _mm256_storeu_ps(d[2] + j, r2), _mm256_storeu_ps(d[3] + j, r3);
+      _mm256_storeu_ps(d[4] + j, r4), _mm256_storeu_ps(d[5] + j, r5), _mm256_storeu_ps(d[6] + j, r6), _mm256_storeu_ps(d[7] + j, r7);
+    }
+  for (; j < n; ++j)
+    for (int l = 0; l < lanes; ++l) std::memcpy(d[l] + j, s + j * 8 + static_cast<std::size_t>(l), 4);
+}
+
+/// fs_kernel8 with the layers in the lanes (LayerGroupDitherer's comment): per colour material k
+/// one vector holds the eight layers' values, so that the choice is a vertical max and a
+/// compare, and void lanes are masked instead of branched over. The floats are fs_kernel8's
+/// for the same lane, and cmykw_fractions' for the fractions (max and min equal its compares on
+/// the clamped, NaN-free values; the clamps keep its NaN -> 0); the carry w0 (v - hit) equals
+/// fs_kernel8's select between w0 v and w0 (v - 1) (v - 0 is v). So each layer's choices equal
+/// the single-layer kernel's. (Computing the carry for both outcomes before the choice, as
+/// fs_kernel8 does to shorten its chain, measured no faster here: eight layers per step make the
+/// loop bound by its instructions and registers, not its chain.) The only difference: a void lane's error is +0 where the
+/// single-layer kernel skips it, which can turn a -0 into +0, and a zero's sign never
+/// reaches a comparison or a nonzero sum.
+[[gnu::target("avx2"), gnu::always_inline]] inline void group_kernel(const GroupRow& a) {
+  constexpr int K = group_k, S = group_stride;
+  const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  const int nx = a.nx, dir = a.left_to_right ? 1 : -1;
+  int x = a.left_to_right ? 0 : nx - 1;
+  const float* in = a.in + S;
+  float* down = a.down + S;
+  const std::int32_t* cell = a.cell + 8;
+  const float* props = a.props;
+  const std::ptrdiff_t np8 = 8 * static_cast<std::ptrdiff_t>(a.np);
+  const float* pr = props + 8 * a.ir;
+  const float* pg = props + 8 * a.ig;
+  const float* pb = props + 8 * a.ib;
+  std::int32_t* rgba = a.rgba;
+  const __m256i table = a.colours;
+  const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
+  __m256 acc_here[K], acc_fwd[K], carry[K];
+  for (int k = 0; k < K; ++k) acc_here[k] = acc_fwd[k] = carry[k] = zero;
+  // The counts in memory (L1): registers are short (the loop's state is 15 vectors).
+  alignas(32) float cnt[K][8] = {};
+  for (int t = 0; t < nx; ++t, x += dir) {
+    const std::ptrdiff_t xs = x;
+    const float* e = in + xs * S;
+    float* d_back = down + (xs - dir) * S;
+    const __m256i live_i = _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + xs * 8)), minus1);
+    if (_mm256_testz_si256(live_i, live_i)) {
+      // Every layer void here: the error aimed here is dropped, none leaves.
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_setzero_si256());
+      for (int k = 0; k < K; ++k) {
+        _mm256_storeu_ps(d_back + 8 * k, acc_here[k]);
+        acc_here[k] = acc_fwd[k];
+        acc_fwd[k] = carry[k] = zero;
+      }
+      continue;
+    }
+    const __m256 live = _mm256_castsi256_ps(live_i);
+    const bool last = t + 1 == nx;
+    // The forward neighbour's availability differs per layer (its voids); the rest does not.
+    const __m256 fwd = _mm256_castsi256_ps(
+        _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + (xs + dir) * 8)), minus1));
+    const int base_mask = (t > 0 ? has_down_back : 0) | (!last ? has_down_forward : 0);
+    const __m256* w_with = a.weights[last ? base_mask : base_mask | has_forward];
+    const __m256* w_without = a.weights[base_mask];
+    __m256 w[4];
+    for (int j = 0; j < 4; ++j) w[j] = _mm256_blendv_ps(w_without[j], w_with[j], fwd);
+
+    // cmykw_fractions, lane by lane: clamp (max(r, 0) is r > 0 ? r : 0, NaN -> 0; then min).
+    const std::ptrdiff_t at = xs * np8;
+    const __m256 r = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pr + at), zero), one);
+    const __m256 g = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pg + at), zero), one);
+    const __m256 b = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pb + at), zero), one);
+    const __m256 m = _mm256_max_ps(r, _mm256_max_ps(g, b));
+    const __m256 wh = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(r, g), b), _mm256_add_ps(m, m));
+    const __m256 s = _mm256_div_ps(one, _mm256_sub_ps(one, _mm256_min_ps(wh, zero)));
+    const __m256 f[K] = {_mm256_mul_ps(_mm256_sub_ps(m, r), s), _mm256_mul_ps(_mm256_sub_ps(m, g), s),
+                         _mm256_mul_ps(_mm256_sub_ps(m, b), s), _mm256_mul_ps(_mm256_sub_ps(one, m), s),
+                         _mm256_max_ps(wh, zero)};
+
+    __m256 v[K], masked[K];
+    for (int k = 0; k < K; ++k) {
+      const __m256 base = _mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k));
+      // f > 0 ? 0 : -3e38, i.e. -3e38 where not f > 0.
+      const __m256 penalty = _mm256_andnot_ps(_mm256_cmp_ps(f[k], zero, _CMP_GT_OQ), none);
+      v[k] = _mm256_add_ps(base, carry[k]);
+      masked[k] = _mm256_add_ps(_mm256_add_ps(base, penalty), carry[k]);
+    }
+    __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
+    mv = _mm256_max_ps(mv, masked[4]);
+    // The lowest material among equal maxima, in live lanes: eq_k and not any eq_j, j < k.
+    __m256 hit[K];
+    __m256 seen = _mm256_cmp_ps(masked[0], mv, _CMP_EQ_OQ);
+    hit[0] = _mm256_and_ps(seen, live);
+    for (int k = 1; k < K; ++k) {
+      const __m256 eq = _mm256_cmp_ps(masked[k], mv, _CMP_EQ_OQ);
+      hit[k] = _mm256_and_ps(_mm256_andnot_ps(seen, eq), live);
+      seen = _mm256_or_ps(seen, eq);
+    }
+    __m256i idx = _mm256_andnot_si256(_mm256_castps_si256(live), seven);  // void: 7
+    for (int k = 1; k < K; ++k) idx = _mm256_or_si256(idx, _mm256_and_si256(_mm256_castps_si256(hit[k]), _mm256_set1_epi32(k)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_permutevar8x32_epi32(table, idx));
+    for (int k = 0; k < K; ++k) {
+      const __m256 h = _mm256_and_ps(hit[k], one);
+      _mm256_store_ps(cnt[k], _mm256_add_ps(_mm256_load_ps(cnt[k]), h));
+      const __m256 err = _mm256_and_ps(live, _mm256_sub_ps(v[k], h));  // +0 in void lanes
+      carry[k] = _mm256_mul_ps(w[0], err);
+      _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
+      acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
+      acc_fwd[k] = _mm256_mul_ps(w[3], err);
+    }
+  }
+  for (int k = 0; k < K; ++k) {
+    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x - dir) * S + 8 * k, acc_here[k]);
+    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x) * S + 8 * k, acc_fwd[k]);
+    a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_load_ps(cnt[k]));
+  }
+}
+
+using GroupKernel = void (*)(const GroupRow&);
+[[gnu::target("avx2")]] void group_kernel_avx2(const GroupRow& a) { group_kernel(a); }
+/// AVX-512VL: the same 8-lane code with 32 vector registers instead of 16 (the loop's state,
+/// 15 vectors, and its temporaries then stay in registers).
+[[gnu::target("avx2,avx512f,avx512vl")]] void group_kernel_avx512vl(const GroupRow& a) { group_kernel(a); }
+GroupKernel group_kernel_for() {
+  static const bool avx512vl = __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512f");
+  if (avx512vl && !std::getenv("TRIVOX_NO_AVX512")) return group_kernel_avx512vl;
+  return group_kernel_avx2;
+}
+
+/// One grouped row: the kernel on the job's buffers (plain pointers, so that callers need no
+/// AVX types), adding the choices of each material and lane to counts.
+[[gnu::target("avx2")]] void group_row(int nx, bool left_to_right, const float (*weights)[4][8], const std::int32_t* cell,
+                                       const float* props, int np, int ir, int ig, int ib, const float* in, float* down,
+                                       const std::int32_t* table, std::int32_t* rgba, float (*counts)[8]) {
+  __m256 c[group_k];
+  for (auto& v : c) v = _mm256_setzero_ps();
+  const GroupRow a{nx, left_to_right, reinterpret_cast<const __m256(*)[4]>(weights), cell, props, np, ir, ig, ib, in, down,
+                   _mm256_loadu_si256(reinterpret_cast<const __m256i*>(table)), rgba, c};
+  group_kernel_for()(a);
+  for (int k = 0; k < group_k; ++k) _mm256_storeu_ps(counts[k], _mm256_add_ps(_mm256_loadu_ps(counts[k]), c[k]));
+}
+
+bool group_kernel_available() noexcept {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+
+#else
+bool group_kernel_available() noexcept { return false; }
+void to_lanes(const void* const*, std::size_t, void*) noexcept {}
+void from_lanes(const void*, std::size_t, int, void* const*) noexcept {}
+void group_row(int, bool, const float (*)[4][8], const std::int32_t*, const float*, int, int, int, int, const float*, float*,
+               const std::int32_t*, std::int32_t*, float (*)[8]) {}
+#endif  // TRIVOX_DITHER_AVX2
+
+/// The fs weights per neighbour-availability mask (forward, down_back, down, down_forward),
+/// renormalised over the available neighbours.
+void mask_weights(double pitch_x, double pitch_y, float (&out)[8][4]) {
+  const DiffusionWeights w = diffusion_weights(pitch_x, pitch_y);
+  for (int mask = 0; mask < 8; ++mask) {
+    const double f = mask & has_forward ? w.forward : 0.0;
+    const double b = mask & has_down_back ? w.down_back : 0.0;
+    const double d = mask & has_down_forward ? w.down_forward : 0.0;
+    const double s = f + b + w.down + d;
+    out[mask][0] = static_cast<float>(f / s);
+    out[mask][1] = static_cast<float>(b / s);
+    out[mask][2] = static_cast<float>(w.down / s);
+    out[mask][3] = static_cast<float>(d / s);
+  }
+}
+
 }  // namespace
 
 DitherMode parse_dither_mode(std::string_view text) {
@@ -529,17 +774,7 @@ LayerDitherer::LayerDitherer(DitherMode mode, int nx, int materials, double pitc
   if (nx < 1) throw Error("dithering: " + std::to_string(nx) + " voxels per row; expected at least 1");
   if (materials < 1 || materials > max_palette_materials)
     throw Error("dithering: " + std::to_string(materials) + " materials; expected 1 to 254");
-  const DiffusionWeights w = diffusion_weights(pitch_x, pitch_y);
-  for (int mask = 0; mask < 8; ++mask) {
-    const double f = mask & has_forward ? w.forward : 0.0;
-    const double b = mask & has_down_back ? w.down_back : 0.0;
-    const double d = mask & has_down_forward ? w.down_forward : 0.0;
-    const double s = f + b + w.down + d;
-    weights_[mask][0] = static_cast<float>(f / s);
-    weights_[mask][1] = static_cast<float>(b / s);
-    weights_[mask][2] = static_cast<float>(w.down / s);
-    weights_[mask][3] = static_cast<float>(d / s);
-  }
+  mask_weights(pitch_x, pitch_y, weights_);
   if (mode_ == DitherMode::fs) {
     const auto stride = static_cast<std::size_t>(error_stride(materials));
     error_.assign(2 * (static_cast<std::size_t>(nx) + 2) * stride, 0.0f);
@@ -655,6 +890,85 @@ void LayerDitherer::none_row(const std::int32_t* cell, const float* fractions, s
       if (f[k] > f[best]) best = k;
     out[x] = static_cast<std::uint8_t>(best);
   }
+}
+
+// ------------------------------------------------------------------------------------------
+// LayerGroupDitherer
+
+bool LayerGroupDitherer::serves(DitherMode mode, const MaterialMapper& mapper) noexcept {
+  return group_kernel_available() && mode == DitherMode::fs && mapper.colour_only() && mapper.materials() >= 5 &&
+         mapper.materials() <= 8 && mapper.colour_materials() == std::array<int, 5>{0, 1, 2, 3, 4};
+}
+
+LayerGroupDitherer::LayerGroupDitherer(int nx, const MaterialMapper& mapper, double pitch_x, double pitch_y)
+    : nx_(nx), np_(mapper.properties()) {
+  if (nx < 1) throw Error("dithering: " + std::to_string(nx) + " voxels per row; expected at least 1");
+  if (!serves(DitherMode::fs, mapper))
+    throw Error("dithering: the grouped kernel needs AVX2 and a colour-only mapper with the colour materials at 0..4 of "
+                "at most 8",
+                ErrorKind::failed);
+  const auto cp = mapper.colour_properties();
+  ir_ = cp[0], ig_ = cp[1], ib_ = cp[2];
+  float w[8][4];
+  mask_weights(pitch_x, pitch_y, w);
+  for (int m = 0; m < 8; ++m)
+    for (int j = 0; j < 4; ++j) std::fill(weights_[m][j], weights_[m][j] + 8, w[m][j]);
+  const auto n = static_cast<std::size_t>(nx), np = static_cast<std::size_t>(np_);
+  error_.assign(2 * (n + 2) * group_stride, 0.0f);
+  props_.assign(n * np * 8, 0.0f);
+  cell_.assign((n + 2) * 8, -1);
+  chosen_.assign(n * 8, 0);
+  no_props_.assign(n * np, 0.0f);
+  no_cells_.assign(n, -1);
+  scratch_.assign(n * 4, 0);
+}
+
+void LayerGroupDitherer::begin(int layers) {
+  if (layers < 1 || layers > max_layers)
+    throw Error("dithering: a group of " + std::to_string(layers) + " layers; expected 1 to " + std::to_string(max_layers),
+                ErrorKind::failed);
+  layers_ = layers;
+  next_row_ = 0;
+  std::fill(error_.begin(), error_.end(), 0.0f);
+}
+
+void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
+                                      const std::array<std::uint32_t, 256>& colours, std::uint8_t* const* rgba,
+                                      std::int64_t* const* counts) {
+  if (layers_ < 1) throw Error("dithering: dither_paint before begin()", ErrorKind::failed);
+  if (row < 0 || row < next_row_)
+    throw Error("dithering: row " + std::to_string(row) + " after rows up to " + std::to_string(next_row_ - 1) +
+                    "; expected increasing rows (error diffusion runs downwards)",
+                ErrorKind::failed);
+  if (row > next_row_) std::fill(error_.begin(), error_.end(), 0.0f);
+  next_row_ = row + 1;
+  // The layers' rows into lanes (lanes without a layer: void cells, zero properties).
+  const auto nx = static_cast<std::size_t>(nx_), np = static_cast<std::size_t>(np_);
+  const void* cs[8];
+  const void* ps[8];
+  void* outs[8];
+  for (int l = 0; l < 8; ++l) {
+    const bool used = l < layers_;
+    cs[l] = used ? static_cast<const void*>(cell[l]) : no_cells_.data();
+    ps[l] = used ? static_cast<const void*>(props[l]) : no_props_.data();
+    outs[l] = used ? static_cast<void*>(rgba[l]) : scratch_.data();
+  }
+  to_lanes(cs, nx, cell_.data() + 8);
+  to_lanes(ps, nx * np, props_.data());
+  const std::size_t half = error_.size() / 2;
+  float* in = error_.data() + (row % 2 == 0 ? 0 : half);
+  float* down = error_.data() + (row % 2 == 0 ? half : 0);
+  std::int32_t table[8] = {};
+  for (int k = 0; k < group_k; ++k) table[k] = static_cast<std::int32_t>(colours[static_cast<std::size_t>(k)]);
+  table[7] = static_cast<std::int32_t>(colours[void_material]);
+  float lane_counts[group_k][8] = {};
+  group_row(nx_, row % 2 == 0, weights_, cell_.data(), props_.data(), np_, ir_, ig_, ib_, in, down, table,
+            chosen_.data(), lane_counts);
+  from_lanes(chosen_.data(), nx, layers_, outs);
+  std::fill(in, in + group_stride, 0.0f);  // as fs_row
+  std::fill(in + half - group_stride, in + half, 0.0f);
+  for (int l = 0; l < layers_; ++l)
+    for (int k = 0; k < group_k; ++k) counts[l][k] += static_cast<std::int64_t>(lane_counts[k][l]);
 }
 
 }  // namespace trivox::slice

@@ -391,3 +391,100 @@ TEST_CASE("dither_paint: one pass of map, dither and paint equals the three step
       CHECK(counts == want_counts);
     }
 }
+
+TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone", "[dither]") {
+  // Layers with their own colour fields (some out of reach, some NaN) and their own voids
+  // (holes, a void row, void runs, a layer entirely void), in groups of 1 to 8 layers, rows
+  // given one at a time with a skipped row; also rows of 1 and 2 voxels.
+  const std::vector<std::string> names = {"r", "g", "b", "density"};
+  const int np = 4;
+  if (!LayerGroupDitherer::serves(DitherMode::fs, MaterialMapper(default_palette(), names))) {
+    WARN("this CPU has no AVX2: the print job dithers one layer at a time, the grouped kernel is not built for it");
+    return;
+  }
+  for (const int nx : {1, 2, 97}) {
+    const int ny = 23, layers = 8;
+    std::vector<std::vector<std::int32_t>> cell(layers, std::vector<std::int32_t>(static_cast<std::size_t>(nx) * ny, 0));
+    std::vector<std::vector<float>> props(layers, std::vector<float>(cell[0].size() * np));
+    std::mt19937 rng(11 + nx);
+    std::uniform_real_distribution<float> u(-0.1f, 1.1f);
+    for (int l = 0; l < layers; ++l)
+      for (int y = 0; y < ny; ++y)
+        for (int x = 0; x < nx; ++x) {
+          const std::size_t v = static_cast<std::size_t>(y) * nx + x;
+          const float s = 0.5f + 0.5f * std::sin(0.07f * x + 0.13f * y + 0.9f * l);
+          props[l][v * np] = (x % 7 == l % 7) ? u(rng) : s;
+          props[l][v * np + 1] = (x % 13 == 0) ? std::nanf("") : 1.0f - s;
+          props[l][v * np + 2] = (y % 4 == l % 4) ? u(rng) : 0.3f * s;
+          props[l][v * np + 3] = u(rng);
+          if ((x * (l + 3) + y * 5) % 11 == 0 || y == 9 + l || (x > 20 + 3 * l && x < 30 + 4 * l) || l == 6) cell[l][v] = -1;
+        }
+    for (const bool five : {false, true}) {
+      Palette palette = default_palette();
+      if (five) palette.materials.resize(5);
+      const MaterialMapper mapper(palette, names);
+      REQUIRE(LayerGroupDitherer::serves(DitherMode::fs, mapper));
+      const int nm = mapper.materials();
+      std::array<std::uint32_t, 256> colours{};
+      for (int k = 0; k < nm; ++k) std::memcpy(&colours[static_cast<std::size_t>(k)], palette.materials[static_cast<std::size_t>(k)].rgba.data(), 4);
+      auto row_skipped = [](int y) { return y == 15; };
+      // Each layer alone.
+      std::vector<std::vector<std::uint8_t>> want(layers, std::vector<std::uint8_t>(cell[0].size() * 4, 0));
+      std::vector<std::vector<std::int64_t>> want_counts(layers, std::vector<std::int64_t>(static_cast<std::size_t>(nm), 0));
+      for (int l = 0; l < layers; ++l) {
+        LayerDitherer d(DitherMode::fs, nx, nm, 0.0423, 0.0847);
+        d.begin_layer(l);
+        for (int y = 0; y < ny; ++y) {
+          if (row_skipped(y)) continue;
+          const std::size_t at = static_cast<std::size_t>(y) * nx;
+          d.dither_paint(y, cell[l].data() + at, props[l].data() + at * np, mapper, colours, want[l].data() + 4 * at,
+                         want_counts[l].data());
+        }
+      }
+      LayerGroupDitherer g(nx, mapper, 0.0423, 0.0847);
+      for (int size = 1; size <= layers; ++size) {
+        // The layers in groups of `size` (the last one smaller).
+        std::vector<std::vector<std::uint8_t>> got(layers, std::vector<std::uint8_t>(cell[0].size() * 4, 9));
+        std::vector<std::vector<std::int64_t>> got_counts(layers, std::vector<std::int64_t>(static_cast<std::size_t>(nm), 0));
+        for (int l0 = 0; l0 < layers; l0 += size) {
+          const int n = std::min(size, layers - l0);
+          g.begin(n);
+          for (int y = 0; y < ny; ++y) {
+            if (row_skipped(y)) continue;
+            const std::size_t at = static_cast<std::size_t>(y) * nx;
+            const std::int32_t* c[8];
+            const float* p[8];
+            std::uint8_t* o[8];
+            std::int64_t* k[8];
+            for (int i = 0; i < n; ++i) {
+              c[i] = cell[l0 + i].data() + at;
+              p[i] = props[l0 + i].data() + at * np;
+              o[i] = got[l0 + i].data() + 4 * at;
+              k[i] = got_counts[l0 + i].data();
+            }
+            g.dither_paint(y, c, p, colours, o, k);
+          }
+        }
+        for (int l = 0; l < layers; ++l) {
+          INFO("nx " << nx << ", " << nm << " materials, groups of " << size << ", layer " << l);
+          // Rows skipped stay as they were (9): the same rows are compared.
+          for (int y = 0; y < ny; ++y)
+            if (row_skipped(y))
+              std::fill(got[l].begin() + 4 * y * nx, got[l].begin() + 4 * (y + 1) * nx, 0);
+          CHECK(got[l] == want[l]);
+          CHECK(got_counts[l] == want_counts[l]);
+        }
+      }
+    }
+  }
+  // Bad use.
+  const MaterialMapper mapper(default_palette(), names);
+  CHECK_THROWS_AS(LayerGroupDitherer(0, mapper, 0.0423, 0.0847), trivox::Error);
+  LayerGroupDitherer g(4, mapper, 0.0423, 0.0847);
+  CHECK_THROWS_AS(g.begin(0), trivox::Error);
+  CHECK_THROWS_AS(g.begin(9), trivox::Error);
+  Palette moved = default_palette();
+  std::swap(moved.materials[0], moved.materials[5]);
+  CHECK_FALSE(LayerGroupDitherer::serves(DitherMode::fs, MaterialMapper(moved, names)));
+  CHECK_FALSE(LayerGroupDitherer::serves(DitherMode::stochastic, mapper));
+}
