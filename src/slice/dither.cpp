@@ -603,6 +603,12 @@ struct GroupRow {
   for (int k = 0; k < K; ++k) acc_here[k] = acc_fwd[k] = carry[k] = zero;
   // The counts in memory (L1): registers are short (the loop's state is 15 vectors).
   alignas(32) float cnt[K][8] = {};
+  // The weights of the first, middle and last columns (the forward neighbour's per lane).
+  const __m256* first_with = a.weights[nx > 1 ? has_forward | has_down_forward : 0];
+  const __m256* first_without = a.weights[nx > 1 ? has_down_forward : 0];
+  const __m256* mid_with = a.weights[has_forward | has_down_back | has_down_forward];
+  const __m256* mid_without = a.weights[has_down_back | has_down_forward];
+  const __m256* last_without = a.weights[nx > 1 ? has_down_back : 0];
   for (int t = 0; t < nx; ++t, x += dir) {
     const std::ptrdiff_t xs = x;
     const float* e = in + xs * S;
@@ -623,9 +629,8 @@ struct GroupRow {
     // The forward neighbour's availability differs per layer (its voids); the rest does not.
     const __m256 fwd = _mm256_castsi256_ps(
         _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + (xs + dir) * 8)), minus1));
-    const int base_mask = (t > 0 ? has_down_back : 0) | (!last ? has_down_forward : 0);
-    const __m256* w_with = a.weights[last ? base_mask : base_mask | has_forward];
-    const __m256* w_without = a.weights[base_mask];
+    const __m256* w_with = t == 0 ? first_with : last ? last_without : mid_with;
+    const __m256* w_without = t == 0 ? first_without : last ? last_without : mid_without;
     __m256 w[4];
     for (int j = 0; j < 4; ++j) w[j] = _mm256_blendv_ps(w_without[j], w_with[j], fwd);
 
@@ -641,13 +646,13 @@ struct GroupRow {
                          _mm256_mul_ps(_mm256_sub_ps(m, b), s), _mm256_mul_ps(_mm256_sub_ps(one, m), s),
                          _mm256_max_ps(wh, zero)};
 
+    // The candidates are the materials the voxel holds: masked = v where f > 0, else -3e38.
+    // (fs_kernel8 adds -3e38 to the others instead; either way they are far below the largest
+    // held value, which is the same float, and so are the choice and the ties.)
     __m256 v[K], masked[K];
     for (int k = 0; k < K; ++k) {
-      const __m256 base = _mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k));
-      // f > 0 ? 0 : -3e38, i.e. -3e38 where not f > 0.
-      const __m256 penalty = _mm256_andnot_ps(_mm256_cmp_ps(f[k], zero, _CMP_GT_OQ), none);
-      v[k] = _mm256_add_ps(base, carry[k]);
-      masked[k] = _mm256_add_ps(_mm256_add_ps(base, penalty), carry[k]);
+      v[k] = _mm256_add_ps(_mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k)), carry[k]);
+      masked[k] = _mm256_blendv_ps(none, v[k], _mm256_cmp_ps(f[k], zero, _CMP_GT_OQ));
     }
     __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
     mv = _mm256_max_ps(mv, masked[4]);
