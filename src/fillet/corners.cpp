@@ -10,7 +10,6 @@
 #include "fillet_util.hpp"
 #include "trivox/error.hpp"
 #include "trivox/fillet/ruled_fillet.hpp"
-#include "trivox/geom/closest_point.hpp"
 #include "trivox/geom/surface_intersection.hpp"
 #include "trivox/spline/calculus.hpp"
 #include "trivox/spline/extract.hpp"
@@ -206,7 +205,7 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
   const Curve bd = trace_bd(s, f, in, tol, qa.bd_samples[0]);
   const Curve ouv = constant_curve(bd.knots(0), in.o_uv);
   SubregionOptions so = sopt;
-  so.tolerance = tol;
+  so.tolerance = 0.25 * tol;  // the neighbours fit to tol: their end sections and ours then differ by little more
   if (so.method == SubregionMethod::matched) so.method = SubregionMethod::automatic;
   const Surface fan = g == 0 ? subregion(s, bd, ouv, so) : subregion(s, ouv, bd, so);
   // The segment o r on the other body, constant in phi: the singular face.
@@ -301,6 +300,7 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
   qa.det_max = -qa.det_min;
   for (std::size_t c = 0; c < 2; ++c) {
     const auto rg = det_range(out.cells[c]);
+    qa.cell_jacobian[c] = rg;
     qa.det_min = std::min(qa.det_min, rg[0]);
     qa.det_max = std::max(qa.det_max, rg[1]);
     qa.cell_volume[c] = std::abs(boundary_volume(out.cells[c]));
@@ -311,17 +311,17 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
 
 namespace {
 
-/// Largest distance from samples of `face` to the nearest of `targets` (the neighbours' end faces).
-double end_gap(const Surface& face, const std::vector<geom::SurfaceDistance>& targets) {
+/// Largest xyz distance between two faces at the same relative parameters (13 x 13 samples).
+double face_gap(const Surface& a, const Surface& b) {
   double worst = 0.0;
   constexpr int n = 12;
-  const auto du = face.domain(0), dv = face.domain(1);
-  for (int a = 0; a <= n; ++a)
-    for (int b = 0; b <= n; ++b) {
-      const Vec x = xyz(face.eval({du[0] + (du[1] - du[0]) * a / n, dv[0] + (dv[1] - dv[0]) * b / n}));
-      double best = std::numeric_limits<double>::infinity();
-      for (const auto& t : targets) best = std::min(best, t.closest(x).distance);
-      worst = std::max(worst, best);
+  const auto au = a.domain(0), av = a.domain(1), bu = b.domain(0), bv = b.domain(1);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const double s = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
+      const Vec x = xyz(a.eval({au[0] + (au[1] - au[0]) * s, av[0] + (av[1] - av[0]) * t}));
+      const Vec y = xyz(b.eval({bu[0] + (bu[1] - bu[0]) * s, bv[0] + (bv[1] - bv[0]) * t}));
+      worst = std::max(worst, norm(sub(x, y)));
     }
   return worst;
 }
@@ -507,8 +507,11 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
     const std::string where = "fillet corner at " + at(jn.o) + " between " + piece_name(pa, side1, side2) + " and " +
                               piece_name(pb, side1, side2);
     std::array<bool, 2> meet{};
-    for (std::size_t s = 0; s < 2; ++s) meet[s] = norm(sub(ea.rail[s], eb.rail[s])) <= jt;
-    if (meet[0] && meet[1]) {
+    for (std::size_t s = 0; s < 2; ++s) {
+      jn.rail_gap[s] = norm(sub(ea.rail[s], eb.rail[s]));
+      meet[s] = jn.rail_gap[s] <= jt;
+    }
+    if ((meet[0] && meet[1]) || jn.angle <= co.smooth_angle) {
       jn.kind = JunctionKind::smooth;
       continue;
     }
@@ -573,29 +576,17 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
                      piece_name(pb, side1, side2));
     }
     cf.junction = jidx;
-    // C0 glue: the bridge's end faces against the neighbours' cells' end faces.
+    // C0 glue: the bridge's end faces against the neighbours' end faces at the same (v, w),
+    // cell for cell (both are ruled halves: v from the rail to C, w from S^_i to S_b); the
+    // pair of ends (u0 or u1 of each) that fits best is the junction.
     for (std::size_t side = 0; side < 2; ++side) {
       const FilletPiece& nb = side == 0 ? pa : pb;
-      std::vector<geom::SurfaceDistance> targets;
-      for (const Fillet& fl : nb.fillets)
-        for (const Trivariate& c : fl.cells)
-          for (spline::Face fc : {spline::Face::u0, spline::Face::u1})
-            targets.emplace_back(spline::coordinates(spline::boundary_face(c, fc), 0, 3));
-      // Which of the bridge's u-ends faces this neighbour: the one nearer its rail end p (or q).
-      const Vec pe = side == 0 ? jn.p : jn.q;
       double best = std::numeric_limits<double>::infinity();
-      for (spline::Face fc : {spline::Face::u0, spline::Face::u1}) {
-        double worst = 0.0, near = std::numeric_limits<double>::infinity();
-        for (const Trivariate& c : cf.cells) {
-          const Surface bf = spline::boundary_face(c, fc);
-          worst = std::max(worst, end_gap(bf, targets));
-          const auto du = bf.domain(0), dv = bf.domain(1);
-          for (int a = 0; a <= 8; ++a)
-            for (int b = 0; b <= 8; ++b)
-              near = std::min(near, norm(sub(xyz(bf.eval({du[0] + (du[1] - du[0]) * a / 8, dv[0] + (dv[1] - dv[0]) * b / 8})), pe)));
-        }
-        if (near <= jt && worst < best) best = worst;
-      }
+      for (const Fillet& fl : nb.fillets)
+        for (spline::Face fn : {spline::Face::u0, spline::Face::u1})
+          for (spline::Face fb : {spline::Face::u0, spline::Face::u1})
+            best = std::min(best, std::max(face_gap(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn)),
+                                           face_gap(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn))));
       cf.quality.glue[side] = best;
     }
     out.corners.push_back(std::move(cf));

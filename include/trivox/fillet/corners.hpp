@@ -9,7 +9,8 @@
 /// Step 1 (Sec. 6): one fillet per face pair and intersection component (fillet_faces, any
 /// sub-region method, the ruled construction of Alg. 2). The pieces are chained where their end
 /// points o coincide (within the join tolerance). At each junction the rails' ends are compared:
-/// - both sides' rails meet: the faces join G1 there (the lamp of Fig. 15): nothing to add;
+/// - both sides' rails meet, or C turns by less than CornerOptions::smooth_angle: the faces join
+///   G1 there (the lamp of Fig. 15): nothing to add;
 /// - one side's rails meet (its body has an edge through o, perpendicular to the other body's
 ///   face there, so both its rails end on that edge at the same point r) and the other side's
 ///   leave a gap between p (the last point of one piece's rail) and q (the first of the next):
@@ -80,6 +81,10 @@ struct CornerOptions {
   /// How close the pieces' ends, and rails' ends, must be to count as one point (model units);
   /// <= 0: the larger of 100 fillet tolerances and 1e-4 of the smaller distance.
   double join_tolerance = 0.0;
+  /// Junctions where C turns by at most this angle (rad) are G1 joins (smooth), whatever the
+  /// small gap between their rails (faces that only approximate one smooth surface, such as the
+  /// primitives' cubic circles, join with a slight kink); > 0.
+  double smooth_angle = 1e-2;
 };
 
 /// One C_{i,j}: a component of S_{1,i} n S_{2,j} and its fillets.
@@ -109,6 +114,7 @@ struct Junction {
   /// side's rails meet at r
   int gap_side = -1;
   std::array<double, 3> o{}, p{}, q{}, r{};
+  std::array<double, 2> rail_gap{};  ///< distance between the two pieces' rail ends, per side
 };
 
 struct CornerQuality {
@@ -118,9 +124,11 @@ struct CornerQuality {
   double r_error = 0.0;       ///< max distance of the blend's other rail from r
   double g1_angle = 0.0;      ///< max angle (rad) between S_b and S_g's tangent plane along B
   double det_min = 0.0, det_max = 0.0;  ///< det J at interior samples of both cells
+  std::array<std::array<double, 2>, 2> cell_jacobian{};  ///< per cell: sampled det J min, max
   std::array<double, 2> cell_volume{};  ///< |int det J| per cell (divergence theorem)
-  /// max distance from the bridge's end faces (phi = 0, phi = 1) to the neighbouring pieces'
-  /// fillet cells (fillet_across; 0 from bridge_corner alone)
+  /// C0 glue: max xyz distance between the bridge's end faces (phi = 0, phi = 1) and the
+  /// neighbouring pieces' end faces at the same (v, w), cell for cell (fillet_across; 0 from
+  /// bridge_corner alone)
   std::array<double, 2> glue{};
   std::array<int, 2> bd_samples{};  ///< samples of B_d; Greville rows of the section
   double seconds = 0.0;
