@@ -439,7 +439,6 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
   // at one end leaves at the other. Pieces in other chains follow in their own walks.
   std::vector<bool> used(np, false);
   std::vector<std::size_t> order;
-  std::vector<int> leave_end;  // the end each ordered piece leaves by (its arriving end at the next junction)
   std::vector<Junction> junctions;
   int chains = 0;
   bool any_open = false;
@@ -462,12 +461,10 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
     ++chains;
     std::size_t cur = startp;
     int in_end = enter;
-    const std::size_t first = order.size();
     while (true) {
       used[cur] = true;
       order.push_back(cur);
       const int out_end = 1 - in_end;
-      leave_end.push_back(out_end);
       if (pieces[cur].closed) break;
       const long m = mate[cur][static_cast<std::size_t>(out_end)];
       if (m < 0) {
@@ -477,16 +474,13 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
       const std::size_t nxt = static_cast<std::size_t>(m / 2);
       const int ne = static_cast<int>(m % 2);
       Junction jn;
-      jn.piece = {order.size() - 1, 0};  // fixed below to ordered indices
+      jn.piece = {cur, nxt};  // input indices; chain indices below
       jn.end = {out_end, ne};
-      jn.piece[1] = nxt;  // original index for now
-      jn.piece[0] = cur;
       junctions.push_back(jn);
       if (used[nxt]) break;  // closed the loop
       cur = nxt;
       in_end = ne;
     }
-    (void)first;
   }
   out.closed = chains == 1 && !any_open && !pieces[order.front()].closed;
   // Re-index pieces in chain order.
