@@ -36,6 +36,9 @@ struct CellQuality {
   /// so its verdict is the sign of det J inside, from the fillet's own report.
   const fillet::FilletQuality* fillet = nullptr;
   std::size_t fillet_cell = 0;  ///< its index among the fillet's cells (FilletQuality::cell_jacobian)
+  /// A bridging fillet's half (seed 000 Sec. 6.1): singular on the edge by construction, judged
+  /// the same way from its own report.
+  const fillet::CornerQuality* corner = nullptr;
   geom::ValidityReport<3> validity;
   double volume = 0.0;
 };
@@ -91,8 +94,9 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
   double total = 0.0;
   for (std::size_t i = 0; i < cells.size(); ++i) {
     const auto& r = q[i].validity;
-    if (const auto* f = q[i].fillet) {
-      const auto& det = f->cell_jacobian.at(q[i].fillet_cell);
+    if (q[i].fillet || q[i].corner) {
+      const auto& det = q[i].fillet ? q[i].fillet->cell_jacobian.at(q[i].fillet_cell)
+                                    : q[i].corner->cell_jacobian.at(q[i].fillet_cell);
       const bool ok = det[0] > 0.0;
       valid = valid && ok;
       total += q[i].volume;
@@ -204,6 +208,34 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                   {"min_jacobian", b.quality.det_min},
                   {"max_jacobian", b.quality.det_max},
                   {"seconds", b.seconds}});
+  // Fillets over several faces (seed 000 Sec. 6.1): the bridging fillets at convex corners.
+  nlohmann::ordered_json jk = nlohmann::ordered_json::array();
+  for (const auto& c : built.corners) {
+    const auto& q2 = c.quality;
+    const auto& jn = c.junction;
+    jk.push_back({{"name", c.name},
+                  {"cells", c.cell_names},
+                  {"pieces", c.pieces},
+                  {"gap_face", c.faces[0]},
+                  {"edge_face", c.faces[1]},
+                  {"o", jn.o},
+                  {"p", jn.p},
+                  {"q", jn.q},
+                  {"r", jn.r},
+                  {"angle", jn.angle},
+                  {"end_error", q2.end_error},
+                  {"radius_error", q2.radius_error},
+                  {"o_error", q2.o_error},
+                  {"r_error", q2.r_error},
+                  {"g1_angle", q2.g1_angle},
+                  {"glue", q2.glue},
+                  {"jacobian", q2.jacobian()},
+                  {"min_jacobian", q2.det_min},
+                  {"max_jacobian", q2.det_max},
+                  {"cell_volume", q2.cell_volume},
+                  {"samples", q2.bd_samples},
+                  {"seconds", q2.seconds}});
+  }
   return {{"scene", opt.scene},
           {"model", opt.output},
           {"units", built.model.units},
@@ -214,6 +246,7 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
           {"primitives", jp},
           {"fillets", jf},
           {"bridges", jb},
+          {"corners", jk},
           {"surfaces", scene_surfaces(built)},
           {"constructs", constructs(built)}};
 }
@@ -294,6 +327,24 @@ void print_human(const nlohmann::ordered_json& j) {
                   fmt(b["seconds"].get<double>(), 3).c_str());
     }
   }
+  if (!j["corners"].empty()) {
+    std::printf("\n%-14s %-30s %11s %11s %11s %-13s %12s %8s\n", "corner", "o", "rail error", "glue", "G1 (rad)",
+                "det J", "volume", "seconds");
+    for (const auto& c : j["corners"]) {
+      const auto& o = c["o"];
+      const std::string at = "(" + fmt(o[0].get<double>(), 6) + ", " + fmt(o[1].get<double>(), 6) + ", " +
+                             fmt(o[2].get<double>(), 6) + ")";
+      const double rail = std::max({c["end_error"].get<double>(), c["radius_error"].get<double>(),
+                                    c["o_error"].get<double>(), c["r_error"].get<double>()});
+      std::printf("%-14s %-30s %11s %11s %11s %-13s %12s %8s\n",
+                  c["cells"][0].get<std::string>().substr(0, c["cells"][0].get<std::string>().size() - 1).c_str(),
+                  at.c_str(), fmt(rail, 3).c_str(),
+                  fmt(std::max(c["glue"][0].get<double>(), c["glue"][1].get<double>()), 3).c_str(),
+                  fmt(c["g1_angle"].get<double>(), 3).c_str(), c["jacobian"].get<std::string>().c_str(),
+                  fmt(c["cell_volume"][0].get<double>() + c["cell_volume"][1].get<double>(), 8).c_str(),
+                  fmt(c["seconds"].get<double>(), 3).c_str());
+    }
+  }
   if (!j["surfaces"].empty()) {
     std::printf("\n%-14s %-7s %-9s %-10s %s\n", "surface", "kind", "orders", "counts", "accuracy");
     for (const auto& s : j["surfaces"]) {
@@ -356,11 +407,22 @@ void add_build(CLI::App& app, Common& common) {
               q[i].fillet = &f.quality[k];
               q[i].fillet_cell = static_cast<std::size_t>(&name - f.cell_names[k].data());
             }
+    for (const auto& c : built.corners)
+      for (std::size_t h = 0; h < 2; ++h)
+        for (std::size_t i = 0; i < built.model.cells.size(); ++i)
+          if (built.model.cells[i].name == c.cell_names[h]) {
+            q[i].corner = &c.quality;
+            q[i].fillet_cell = h;
+          }
     tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
       // A fillet cell's volume comes with its report (the same integral over its faces: the
       // VBS cells' thousand-by-hundred elements made geom::volume take seconds).
       if (q[i].fillet) {
         q[i].volume = q[i].fillet->cell_volume.at(q[i].fillet_cell);
+        return;
+      }
+      if (q[i].corner) {
+        q[i].volume = q[i].corner->cell_volume.at(q[i].fillet_cell);
         return;
       }
       q[i].volume = geom::volume(*geometry[i]);

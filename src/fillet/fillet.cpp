@@ -315,7 +315,8 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
                 "); expected faces that cross along a curve");
   }
   std::vector<Fillet> out;
-  for (const auto& curve : curves) {
+  for (std::size_t ci = 0; ci < curves.size(); ++ci) {
+    const geom::IntersectionCurve& curve = curves[ci];
     if (curve.points.size() < 2 || curve.xyz.size() == 0)
       throw Error("fillet: the faces touch at a point (" + num(curve.points[0].xyz[0]) + ", " +
                   num(curve.points[0].xyz[1]) + ", " + num(curve.points[0].xyz[2]) +
@@ -408,7 +409,11 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
       }
     }
     if (made.empty()) made.push_back(make(whole_part()));
-    for (auto& f : made) out.push_back(std::move(f));
+    for (auto& f : made) {
+      f.rails = rp;
+      f.component = ci;
+      out.push_back(std::move(f));
+    }
   }
   return out;
 }

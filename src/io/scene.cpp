@@ -212,12 +212,54 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
 void read_fillet(const Source& src, const json& item, const std::string& ip, SceneOperation& o) {
   const std::string what =
       "a fillet {\"op\": \"fillet\", \"between\": [A, B], \"distance\", \"tau\", \"section\", \"dip\", "
-      "\"method\", \"blend\", \"power\", \"flip\", \"construction\", \"bridge\", \"name\"}";
+      "\"method\", \"blend\", \"power\", \"flip\", \"construction\", \"bridge\", \"corners\", \"name\"}";
   const std::string bp = child(ip, "between");
   const json& between = require(src, item, ip, "between", what);
-  const std::string bwhat = "two cells: names or {\"cell\": NAME, \"face\": \"u0\"..\"w1\"}";
+  const std::string bwhat = "two cells: names or {\"cell\": NAME, \"face\": \"u0\"..\"w1\"}, or lists of "
+                            "{\"cell\", \"face\"} (a fillet over several faces)";
   if (!between.is_array() || between.size() != 2) fail_type(src, bp, between, bwhat);
-  for (std::size_t i = 0; i < 2; ++i) {
+  const auto read_face = [&](const json& e, const std::string& ep, SceneOperation::SideFace& out) {
+    if (!e.is_object()) fail_type(src, ep, e, "{\"cell\": NAME, \"face\": \"u0\"..\"w1\"}");
+    out.cell = read_string(src, require(src, e, ep, "cell", bwhat), child(ep, "cell"), "a cell name");
+    if (out.cell.empty()) src.fail(child(ep, "cell"), "empty cell name; expected a cell name");
+    const std::string face =
+        read_string(src, require(src, e, ep, "face", bwhat), child(ep, "face"), "a face name u0 u1 v0 v1 w0 w1");
+    try {
+      out.face = spline::face_from_name(face);
+    } catch (const Error&) {
+      src.fail(child(ep, "face"), "unknown face " + quote(face) + "; expected u0, u1, v0, v1, w0 or w1");
+    }
+    out.pointer = ep;
+  };
+  o.across = between[0].is_array() || between[1].is_array();
+  if (o.across) {
+    // Seed 000 Sec. 6: every listed face of one side against every listed face of the other.
+    for (std::size_t i = 0; i < 2; ++i) {
+      const std::string ep = child(bp, i);
+      const json& e = between[i];
+      if (e.is_object()) {
+        o.sides[i].emplace_back();
+        read_face(e, ep, o.sides[i].back());
+      } else if (e.is_array() && !e.empty()) {
+        for (std::size_t k = 0; k < e.size(); ++k) {
+          o.sides[i].emplace_back();
+          read_face(e[k], child(ep, k), o.sides[i].back());
+          for (std::size_t l = 0; l < k; ++l)
+            if (o.sides[i][l].cell == o.sides[i][k].cell && o.sides[i][l].face == o.sides[i][k].face)
+              src.fail(child(ep, k), quote(o.sides[i][k].cell) + " face " +
+                                         std::string(spline::face_name(o.sides[i][k].face)) + " twice; expected each face once");
+        }
+      } else {
+        fail_type(src, ep, e, "a non-empty list of {\"cell\", \"face\"} or one {\"cell\", \"face\"} (a fillet over several faces names its faces)");
+      }
+      o.between[i] = o.sides[i].front().cell;
+    }
+    for (const auto& a : o.sides[0])
+      for (const auto& b : o.sides[1])
+        if (a.cell == b.cell)
+          src.fail(b.pointer, quote(b.cell) + " on both sides; expected faces of two different bodies");
+  }
+  for (std::size_t i = 0; i < 2 && !o.across; ++i) {
     const std::string ep = child(bp, i);
     const json& e = between[i];
     if (e.is_string()) {
@@ -236,8 +278,23 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     }
     if (o.between[i].empty()) src.fail(ep, "empty cell name; expected " + bwhat);
   }
-  if (o.between[0] == o.between[1]) src.fail(child(bp, 1), quote(o.between[1]) + " twice; expected two different cells");
+  if (!o.across && o.between[0] == o.between[1])
+    src.fail(child(bp, 1), quote(o.between[1]) + " twice; expected two different cells");
   fillet::FilletOptions& f = o.fillet;
+  if (const json* c = find(item, "corners")) {
+    const std::string cp = child(ip, "corners");
+    const std::string v = read_string(src, *c, cp, "\"bridge\" or \"open\"");
+    if (v != "bridge" && v != "open") src.fail(cp, "unknown corners " + quote(v) + "; expected \"bridge\" or \"open\"");
+    if (!o.across)
+      src.fail(cp, "\"corners\" with one face per side; expected lists of faces in \"between\" (a fillet over "
+                   "several faces, seed 000 Sec. 6)");
+    o.corners.bridge = v == "bridge";
+  }
+  if (o.across)
+    for (const char* key : {"bridge", "construction", "blend", "power"})
+      if (find(item, key))
+        src.fail(child(ip, key), std::string("\"") + key + "\" with a fillet over several faces; expected the ruled "
+                                 "construction and the parametric blend (seed 000 Sec. 6 joins ruled fillets)");
   if (const json* b = find(item, "bridge")) {
     if (!b->is_boolean()) fail_type(src, child(ip, "bridge"), *b, "true or false");
     o.bridge = b->get<bool>();
@@ -272,6 +329,9 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     const std::string sec = read_string(src, *t, child(ip, "section"), "\"hermite\" or \"flend\"");
     if (!fillet::section_from_name(sec.c_str(), f.blend.section))
       src.fail(child(ip, "section"), "unknown section " + quote(sec) + "; expected \"hermite\" or \"flend\"");
+    if (o.across && o.corners.bridge && f.blend.section != fillet::Section::hermite)
+      src.fail(child(ip, "section"), "the bridging fillets at corners (seed 000 Sec. 6.1) take the Hermite section; "
+                                     "expected \"section\": \"hermite\", or \"corners\": \"open\"");
     if (o.bridge && f.blend.section != fillet::Section::flend)
       src.fail(child(ip, "section"), "a bridge is a flend (seed 002 Sec. III); expected \"section\": \"flend\"");
   }
@@ -381,6 +441,78 @@ const vmodel::VCell& find_cell(const Source& src, const Objects& objects, const 
                 "<name>.<part>)");
 }
 
+/// Seed 000 Sec. 6 / 6.1: the fillet over several faces (fillet/corners.hpp): its pieces' cells
+/// <name>.<k>a, <name>.<k>b in chain order, the bridges' <name>.c<j>a, <name>.c<j>b.
+template <class Objects>
+std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOperation& op, const Objects& objects,
+                                               SceneBuild& out) {
+  std::array<std::vector<fillet::SideFace>, 2> sides;
+  for (std::size_t i = 0; i < 2; ++i)
+    for (const auto& sf : op.sides[i]) {
+      const std::string ptr = sf.pointer + "/cell";
+      const vmodel::VCell& c = find_cell(src, objects, sf.cell, ptr);
+      if (!c.plain())
+        src.fail(ptr, quote(sf.cell) + " is a trimmed piece of a Boolean; expected a plain cell (fillets of "
+                      "trimmed cells are later work)");
+      if (c.volume.rational()) src.fail(ptr, quote(sf.cell) + " is rational; expected a polynomial cell");
+      sides[i].push_back({&c.volume, sf.face, sf.cell + "/" + std::string(spline::face_name(sf.face))});
+    }
+  fillet::MultiFillet mf;
+  try {
+    mf = fillet::fillet_across(sides[0], sides[1], op.fillet, op.corners);
+  } catch (const Error& e) {
+    throw e.within(src.at(op.pointer));
+  }
+  std::vector<vmodel::VCell> cells;
+  std::size_t k = 0;
+  for (const auto& piece : mf.pieces) {
+    FilletBuild rep;
+    rep.name = op.name;
+    rep.pointer = op.pointer;
+    rep.cells = {op.sides[0][piece.face[0]].cell, op.sides[1][piece.face[1]].cell};
+    rep.faces = {op.sides[0][piece.face[0]].face, op.sides[1][piece.face[1]].face};
+    for (const auto& f : piece.fillets) {
+      const auto& q = f.quality;
+      const std::string base = op.name + "." + std::to_string(++k);
+      if (q.jacobian() == "changes sign")
+        throw Error(src.at(op.pointer) + ": fillet " + base + " between " + sides[0][piece.face[0]].name + " and " +
+                        sides[1][piece.face[1]].name + ": det J changes sign inside (from " + format_double(q.det_min) +
+                        " to " + format_double(q.det_max) + "); expected a valid fillet: try other distances or tau",
+                    ErrorKind::failed);
+      rep.cell_names.push_back({base + "a", base + "b"});
+      rep.quality.push_back(q);
+      for (std::size_t c = 0; c < 2; ++c) cells.push_back(f.vcell(c, rep.cell_names.back()[c]));
+    }
+    out.fillets.push_back(std::move(rep));
+  }
+  const auto piece_name = [&](const fillet::FilletPiece& p) {
+    return sides[0][p.face[0]].name + " x " + sides[1][p.face[1]].name;
+  };
+  for (std::size_t j = 0; j < mf.corners.size(); ++j) {
+    const auto& cf = mf.corners[j];
+    const fillet::Junction& jn = mf.junctions[cf.junction];
+    CornerBuild rep;
+    rep.name = op.name;
+    rep.pointer = op.pointer;
+    const std::string base = op.name + ".c" + std::to_string(j + 1);
+    rep.cell_names = {base + "a", base + "b"};
+    rep.pieces = {piece_name(mf.pieces[jn.piece[0]]), piece_name(mf.pieces[jn.piece[1]])};
+    const std::size_t g = static_cast<std::size_t>(jn.gap_side);
+    rep.faces = {sides[g][mf.pieces[jn.piece[0]].face[g]].name, sides[1 - g][mf.pieces[jn.piece[0]].face[1 - g]].name};
+    rep.junction = jn;
+    rep.quality = cf.quality;
+    if (cf.quality.jacobian() == "changes sign")
+      throw Error(src.at(op.pointer) + ": the bridging fillet " + base + " at the corner (" + format_double(jn.o[0]) +
+                      ", " + format_double(jn.o[1]) + ", " + format_double(jn.o[2]) + "): det J changes sign inside (from " +
+                      format_double(cf.quality.det_min) + " to " + format_double(cf.quality.det_max) +
+                      "); expected a valid fillet: try other distances or tau",
+                  ErrorKind::failed);
+    for (std::size_t c = 0; c < 2; ++c) cells.emplace_back(rep.cell_names[c], cf.cells[c]);
+    out.corners.push_back(std::move(rep));
+  }
+  return cells;
+}
+
 /// Seed 000 Alg. 2 (or Sec. 3.2 / Alg. 3 with "construction": "vbs", Sec. 5 / Alg. 6 with
 /// "vrep") between two cells: the faces (given, or the one intersecting pair), the fillets, their
 /// cells named <name>.<k>a and <name>.<k>b (vbs: <name>.<k>.1, .2, .3; vrep: the trimmed cell
@@ -388,6 +520,7 @@ const vmodel::VCell& find_cell(const Source& src, const Objects& objects, const 
 template <class Objects>
 std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation& op,
                                         const Objects& objects, SceneBuild& out) {
+  if (op.across) return apply_fillet_across(src, op, objects, out);
   std::array<const vmodel::VCell*, 2> cell{};
   for (std::size_t i = 0; i < 2; ++i) {
     const std::string ptr = op.pointer + "/between/" + std::to_string(i);

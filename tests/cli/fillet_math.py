@@ -26,3 +26,12 @@ def hermite_length(d1, d2, tau):
     """The section's arc length, by Gauss on |P'| (not exact: a square root; ample for bounds)."""
     X, Z, dX, dZ, wts = hermite_section(d1, d2, tau)
     return np.sum(wts * np.hypot(dX, dZ))
+
+
+def hermite_moment(d1, d2, tau):
+    """int X dA over the same region (X the distance from the Z axis): by Green's theorem
+    oint X^2 / 2 dZ, where only the section contributes (degree 8: exact with 8 points). A
+    quarter turn of the section about the Z axis (a bridging fillet about a vertical edge on a
+    plane, seed 000 Sec. 6.1) has volume (pi / 2) times this (Pappus)."""
+    X, Z, dX, dZ, wts = hermite_section(d1, d2, tau)
+    return np.sum(wts * 0.5 * X * X * dZ)

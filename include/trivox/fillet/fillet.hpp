@@ -32,6 +32,7 @@
 
 #include "trivox/fillet/blend_surface.hpp"
 #include "trivox/fillet/compose.hpp"
+#include "trivox/fillet/rails.hpp"
 #include "trivox/fillet/vbs_fillet.hpp"
 #include "trivox/fillet/vrep_fillet.hpp"
 #include "trivox/spline/extract.hpp"
@@ -104,6 +105,11 @@ struct Fillet {
   std::vector<spline::Trivariate> beyond;
   std::vector<vmodel::FaceTrim> caps;
   FilletQuality quality;
+  /// The rails of the intersection component this fillet belongs to (over the whole component,
+  /// also for a matched piece of it), and the component's index in intersect_surfaces' order:
+  /// what the multi-face fillet of fillet/corners.hpp (seed 000 Sec. 6) joins at the corners.
+  RailPair rails;
+  std::size_t component = 0;
 
   /// Cell c as a V-model cell called `name`: plain, or for vrep the trimmed V-cell
   /// (VrepFillet::cell: T_hbs without {W_1, W_2}).

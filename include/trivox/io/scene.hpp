@@ -24,6 +24,12 @@
 /// "face": "u0".."w1"}; without faces, the one pair of faces that intersects is used. With
 /// "bridge": true (and both faces named) the fillet is a flend between disjoint faces instead
 /// (fillet/bridge.hpp, seed 002 Sec. III): one cell `<name>.1` from face to face, with "dip".
+/// With a list [{"cell", "face"}, ...] on either side of "between", the fillet runs over several
+/// faces (fillet/corners.hpp, seed 000 Sec. 6): one fillet per pair of listed faces that crosses
+/// along a curve, chained along C, cells `<name>.<k>a`, `<name>.<k>b` in chain order; with
+/// "corners": "bridge" (the default; "open" leaves the gaps, Fig. 12 (c)) each convex C1 corner
+/// gets the singular bridging fillet of Sec. 6.1, cells `<name>.c<j>a`, `<name>.c<j>b`. Ruled
+/// construction, Hermite section and the parametric blend only.
 /// The fillet's cells, two per intersection component (`<name>.<k>a`, `<name>.<k>b`; with
 /// "construction": "vbs", seed 000 Sec. 3.2 / Alg. 3, three: `<name>.<k>.1` at C, `.2` at
 /// rail 1, `.3` at rail 2; with "vrep", Sec. 5 / Alg. 6, one trimmed cell `<name>.<k>`, the
@@ -53,6 +59,7 @@
 #include "trivox/construct/constructors.hpp"
 #include "trivox/construct/primitives.hpp"
 #include "trivox/fillet/bridge.hpp"
+#include "trivox/fillet/corners.hpp"
 #include "trivox/fillet/fillet.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
@@ -122,6 +129,17 @@ struct SceneOperation {
   std::array<std::optional<spline::Face>, 2> faces;
   fillet::FilletOptions fillet;
   bool bridge = false;      ///< "bridge": true: a flend between disjoint faces (fillet/bridge.hpp)
+  /// "between" with a list of {"cell", "face"} on a side: the fillet over several faces of seed
+  /// 000 Sec. 6 (fillet/corners.hpp); sides[i] are side i's (cell, face, pointer) and between[i]
+  /// its first cell. "corners": "bridge" (Sec. 6.1, the default) or "open".
+  struct SideFace {
+    std::string cell;
+    spline::Face face = spline::Face::u0;
+    std::string pointer;
+  };
+  bool across = false;
+  std::array<std::vector<SideFace>, 2> sides;
+  fillet::CornerOptions corners;
   bool shepard = false;     ///< "blend": "shepard" (seed 000 Sec. 7.2), else parametric (Sec. 7.1)
   int shepard_power = 2;    ///< "power": Shepard's q, 1..16
   SceneConstructor constructor;  ///< constructors: their inputs (the result is `name`)
@@ -187,6 +205,17 @@ struct BridgeBuild {
   double seconds = 0.0;
 };
 
+/// What one bridging fillet of a fillet over several faces gave (seed 000 Sec. 6.1): two cells.
+struct CornerBuild {
+  std::string name;                       ///< the operation's result name
+  std::string pointer;                    ///< "/operations/<i>"
+  std::array<std::string, 2> cell_names;  ///< <name>.c<j>a, <name>.c<j>b
+  std::array<std::string, 2> pieces;      ///< the neighbouring pieces, "cell/face x cell/face"
+  std::array<std::string, 2> faces;       ///< the face with the gap (smooth at o), the one with the edge
+  fillet::Junction junction;
+  fillet::CornerQuality quality;
+};
+
 /// What one derived surface gave ("gismo" or "offset").
 struct SurfaceBuild {
   std::string name, kind;
@@ -213,6 +242,7 @@ struct SceneBuild {
   std::vector<PrimitiveBuild> primitives;
   std::vector<FilletBuild> fillets;
   std::vector<BridgeBuild> bridges;
+  std::vector<CornerBuild> corners;  ///< fillets over several faces: the bridging fillets
 };
 
 /// Expands the primitives (named `<name>.<part>`, construct/primitives.hpp) and applies their

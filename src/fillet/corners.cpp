@@ -1,0 +1,591 @@
+#include "trivox/fillet/corners.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "fillet_util.hpp"
+#include "trivox/error.hpp"
+#include "trivox/fillet/ruled_fillet.hpp"
+#include "trivox/geom/surface_intersection.hpp"
+#include "trivox/spline/calculus.hpp"
+#include "trivox/spline/extract.hpp"
+#include "trivox/spline/fit.hpp"
+#include "trivox/spline/refine.hpp"
+
+namespace trivox::fillet {
+
+using spline::Curve;
+using spline::KnotVector;
+using spline::Surface;
+using spline::Trivariate;
+using detail::Vec;
+using namespace detail;
+
+std::string CornerQuality::jacobian() const {
+  if (det_min > 0.0) return "positive";
+  if (det_max < 0.0) return "negative";
+  return "changes sign";
+}
+
+namespace {
+
+std::string at(const Vec& p) { return "(" + num(p[0]) + ", " + num(p[1]) + ", " + num(p[2]) + ")"; }
+
+Vec unit(const Vec& a) {
+  const double n = norm(a);
+  return n > 0.0 ? scale(a, 1.0 / n) : a;
+}
+
+/// Unit normal of s (xyz) at uv; zero where s is singular.
+Vec normal_at(const Surface& s, const std::array<double, 2>& uv) {
+  const auto d = s.eval_derivatives({uv[0], uv[1]}, 1);
+  const std::size_t k = static_cast<std::size_t>(s.dim());
+  return unit(cross(xyz(d.data() + k), xyz(d.data() + 2 * k)));
+}
+
+Vec point_at(const Surface& s, const std::array<double, 2>& uv) { return xyz(s.eval({uv[0], uv[1]})); }
+
+/// A constant curve at uv in the space `knots` (R^2).
+Curve constant_curve(const KnotVector& knots, const std::array<double, 2>& uv) {
+  std::vector<double> pts;
+  for (int i = 0; i < knots.size(); ++i) pts.insert(pts.end(), {uv[0], uv[1]});
+  return Curve({knots}, 2, std::move(pts));
+}
+
+/// B_d (see corners.hpp): the point of s in the half-plane through o spanned by n_o and m, at
+/// distance d from o, by Newton from uv (updated). False when Newton does not converge.
+bool solve_bd(const Surface& s, const Vec& o, const Vec& nu, double d, double tol, std::array<double, 2>& uv) {
+  const auto du = s.domain(0), dv = s.domain(1);
+  const std::size_t k = static_cast<std::size_t>(s.dim());
+  for (int it = 0; it < 60; ++it) {
+    const auto e = s.eval_derivatives({uv[0], uv[1]}, 1);
+    const Vec x = sub(xyz(e.data()), o), xu = xyz(e.data() + k), xv = xyz(e.data() + 2 * k);
+    const double f1 = 0.5 * (dot(x, x) - d * d), f2 = dot(x, nu);
+    if (std::abs(f1) <= 1e-3 * tol * d && std::abs(f2) <= 1e-3 * tol) return true;
+    const double a = dot(x, xu), b = dot(x, xv), c = dot(nu, xu), dd = dot(nu, xv);
+    const double det = a * dd - b * c;
+    if (!(std::abs(det) > 0.0)) return false;
+    double su = (f1 * dd - b * f2) / det, sv = (a * f2 - c * f1) / det;
+    // Damp steps larger than a tenth of the domain (a far start).
+    const double big = 0.1 * std::max(du[1] - du[0], dv[1] - dv[0]);
+    const double len = std::hypot(su, sv);
+    if (len > big) su *= big / len, sv *= big / len;
+    uv = {std::clamp(uv[0] - su, du[0], du[1]), std::clamp(uv[1] - sv, dv[0], dv[1])};
+  }
+  return false;
+}
+
+struct Frame {
+  Vec o, n, a, c;
+  double angle = 0.0, dp = 0.0, dq = 0.0;
+  /// The half-plane normal and the distance at phi.
+  void at(double phi, Vec& nu, double& d) const {
+    const double s = std::sin(angle);
+    const Vec m = unit(axpy(scale(a, std::sin((1.0 - phi) * angle) / s), std::sin(phi * angle) / s, c));
+    nu = unit(cross(n, m));
+    d = (1.0 - phi) * dp + phi * dq;
+  }
+};
+
+/// B_d in s's parameters: samples from p (phi = 0) to q (phi = 1), interpolated, doubled until the
+/// curve is within tol of B_d halfway between samples.
+Curve trace_bd(const Surface& s, const Frame& f, const CornerInput& in, double tol, int& samples) {
+  const auto du = s.domain(0), dv = s.domain(1);
+  const auto off_face = [&](const std::array<double, 2>& uv, double phi) {
+    const double eu = 1e-9 * (du[1] - du[0]), ev = 1e-9 * (dv[1] - dv[0]);
+    return (uv[0] <= du[0] + eu && in.p_uv[0] > du[0] + eu && in.q_uv[0] > du[0] + eu) ||
+                   (uv[0] >= du[1] - eu && in.p_uv[0] < du[1] - eu && in.q_uv[0] < du[1] - eu) ||
+                   (uv[1] <= dv[0] + ev && in.p_uv[1] > dv[0] + ev && in.q_uv[1] > dv[0] + ev) ||
+                   (uv[1] >= dv[1] - ev && in.p_uv[1] < dv[1] - ev && in.q_uv[1] < dv[1] - ev)
+               ? phi
+               : -1.0;
+  };
+  const auto solve = [&](double phi, std::array<double, 2>& uv) {
+    Vec nu;
+    double d = 0.0;
+    f.at(phi, nu, d);
+    if (!solve_bd(s, f.o, nu, d, tol, uv))
+      throw Error("fillet corner at " + at(f.o) + ": the circle B_d of radius " + num(d) +
+                      " on the face does not converge at phi = " + num(phi),
+                  ErrorKind::failed);
+    if (off_face(uv, phi) >= 0.0)
+      throw Error("fillet corner at " + at(f.o) + ": the bridge's rail B_d (radius " + num(d) +
+                  ") leaves the face at phi = " + num(phi) + ", (u, v) = (" + num(uv[0]) + ", " + num(uv[1]) +
+                  "); expected a face that holds the disk of that radius about the corner");
+  };
+  for (int n = 8; n <= 1024; n *= 2) {
+    std::vector<double> params, values;
+    std::array<double, 2> uv = in.p_uv;
+    for (int j = 0; j <= n; ++j) {
+      const double phi = static_cast<double>(j) / n;
+      if (j == 0) {
+        uv = in.p_uv;
+      } else if (j == n) {
+        // Continue onto q, then pin it.
+        std::array<double, 2> end = uv;
+        solve(phi, end);
+        if (norm(sub(point_at(s, end), point_at(s, in.q_uv))) > 100.0 * tol)
+          throw Error("fillet corner at " + at(f.o) + ": B_d from p " + at(point_at(s, in.p_uv)) +
+                          " reaches " + at(point_at(s, end)) + ", not q " + at(point_at(s, in.q_uv)),
+                      ErrorKind::failed);
+        uv = in.q_uv;
+      } else {
+        // Sub-steps from the previous sample, so Newton always starts close.
+        for (int sstep = 1; sstep <= 4; ++sstep) solve((j - 1 + sstep / 4.0) / n, uv);
+      }
+      params.push_back(phi);
+      values.insert(values.end(), {uv[0], uv[1]});
+    }
+    const Curve c = spline::interpolate_curve(params, 2, values, 4);
+    double worst = 0.0;
+    for (int j = 0; j < n; ++j) {
+      const double phi = (j + 0.5) / n;
+      std::array<double, 2> uv2{values[2 * static_cast<std::size_t>(j)], values[2 * static_cast<std::size_t>(j) + 1]};
+      solve(phi, uv2);
+      const auto cu = c.eval({phi});
+      worst = std::max(worst, norm(sub(point_at(s, {cu[0], cu[1]}), point_at(s, uv2))));
+    }
+    if (worst <= tol) {
+      samples = n + 1;
+      return c;
+    }
+  }
+  throw Error("fillet corner at " + at(f.o) + ": B_d does not reach the tolerance " + num(tol) + " with 1025 samples",
+              ErrorKind::failed);
+}
+
+/// det J at interior samples of a cell: per u sample 6 x 4 across.
+std::array<double, 2> det_range(const Trivariate& h) {
+  std::array<double, 2> r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  const auto du = h.domain(0), dv = h.domain(1), dw = h.domain(2);
+  for (int a = 0; a < 24; ++a)
+    for (int b = 0; b < 6; ++b)
+      for (int c = 0; c < 4; ++c) {
+        const double det = jacobian_at(h, {du[0] + (du[1] - du[0]) * (a + 0.5) / 24,
+                                           dv[0] + (dv[1] - dv[0]) * (b + 0.5) / 6, dw[0] + (dw[1] - dw[0]) * (c + 0.5) / 4});
+        r[0] = std::min(r[0], det);
+        r[1] = std::max(r[1], det);
+      }
+  return r;
+}
+
+}  // namespace
+
+CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, double tol, const SubregionOptions& sopt) {
+  const auto start = std::chrono::steady_clock::now();
+  if (in.face == nullptr || in.meet == nullptr) throw Error("fillet corner: no face given");
+  if (blend.section != Section::hermite)
+    throw Error("fillet corner: the bridging fillet (seed 000 Sec. 6.1) takes the Hermite section; expected "
+                "\"section\": \"hermite\" with corners");
+  if (!(tol > 0.0)) throw Error("fillet corner: tolerance " + num(tol) + "; expected a positive value");
+  if (in.face->dim() != in.meet->dim() || in.face->dim() < 3)
+    throw Error("fillet corner: the faces have " + std::to_string(in.face->dim()) + " and " +
+                std::to_string(in.meet->dim()) + " coordinates; expected the same, at least 3");
+  const Surface& s = *in.face;
+  const int g = in.gap_side;
+  Frame f;
+  f.o = point_at(s, in.o_uv);
+  f.n = normal_at(s, in.o_uv);
+  const Vec p = point_at(s, in.p_uv), q = point_at(s, in.q_uv);
+  f.dp = norm(sub(p, f.o));
+  f.dq = norm(sub(q, f.o));
+  f.a = unit(sub(p, f.o));
+  f.c = unit(sub(q, f.o));
+  f.angle = std::acos(std::clamp(dot(f.a, f.c), -1.0, 1.0));
+  if (!(f.dp > 0.0) || !(f.dq > 0.0) || !(f.angle > 1e-9) || !(f.angle < std::numbers::pi - 1e-6) || !(norm(f.n) > 0.0))
+    throw Error("fillet corner at " + at(f.o) + ": p " + at(p) + " and q " + at(q) +
+                " do not span a gap about o; expected rail ends on either side of the corner");
+  CornerFillet out;
+  CornerQuality& qa = out.quality;
+  // The bridge's rail on S_g, and the fan from it to o (Eqs. 2-3 with C collapsed to o).
+  const Curve bd = trace_bd(s, f, in, tol, qa.bd_samples[0]);
+  const Curve ouv = constant_curve(bd.knots(0), in.o_uv);
+  SubregionOptions so = sopt;
+  so.tolerance = 0.25 * tol;  // the neighbours fit to tol: their end sections and ours then differ by little more
+  if (so.method == SubregionMethod::matched) so.method = SubregionMethod::automatic;
+  const Surface fan = g == 0 ? subregion(s, bd, ouv, so) : subregion(s, ouv, bd, so);
+  // The segment o r on the other body, constant in phi: the singular face.
+  const KnotVector lin = KnotVector::bezier(2);
+  const Surface seg = g == 0 ? subregion(*in.meet, constant_curve(lin, in.meet_o_uv), constant_curve(lin, in.meet_r_uv), so)
+                             : subregion(*in.meet, constant_curve(lin, in.meet_r_uv), constant_curve(lin, in.meet_o_uv), so);
+  const Vec r = point_at(*in.meet, in.meet_r_uv);
+  const Vec tb = unit(sub(r, f.o));  // T on the edge: from o towards r
+  // The Hermite section (Alg. 1): Q0 = C_1, Q1 = C_1 + L/3 T_1, Q2 = C_2 - L/3 T_2, Q3 = C_2,
+  // L = tau |C_1 - C_2|; the rail on S_g is the fan's boundary itself.
+  Curve rail = spline::iso(fan, 1, g == 0 ? 0.0 : 1.0);
+  rail = spline::coordinates(rail, 0, 3);
+  const auto section = [&](double phi, Vec& q1, Vec& q2) {
+    const Vec b = xyz(rail.eval({phi}));
+    const auto uv = bd.eval({phi});
+    const Vec n = normal_at(s, {uv[0], uv[1]});
+    const Vec toward = sub(f.o, b);
+    const Vec tg = unit(axpy(toward, -dot(toward, n), n));  // towards o in S_g's tangent plane
+    const double len = blend.tau * norm(sub(b, r)) / 3.0;
+    if (g == 0) {  // rail 1 = B_d, T_1 towards C; rail 2 = r, T_2 from C to r
+      q1 = axpy(b, len, tg);
+      q2 = axpy(r, -len, tb);
+    } else {  // rail 1 = r, T_1 from r towards C; rail 2 = B_d, T_2 away from o
+      q1 = axpy(r, -len, tb);
+      q2 = axpy(b, len, tg);
+    }
+  };
+  KnotVector kv = rail.knots(0);
+  Curve c1, c2;
+  for (int round = 0;; ++round) {
+    const std::vector<double> gr = kv.greville();
+    std::vector<double> v1, v2;
+    for (double phi : gr) {
+      Vec a, b;
+      section(phi, a, b);
+      v1.insert(v1.end(), a.begin(), a.end());
+      v2.insert(v2.end(), b.begin(), b.end());
+    }
+    c1 = spline::interpolate_curve(gr, 3, v1, kv);
+    c2 = spline::interpolate_curve(gr, 3, v2, kv);
+    double worst = 0.0;
+    for (std::size_t j = 0; j + 1 < gr.size(); ++j)
+      for (const double t : {0.25, 0.5, 0.75}) {
+        const double phi = gr[j] + t * (gr[j + 1] - gr[j]);
+        Vec a, b;
+        section(phi, a, b);
+        worst = std::max({worst, norm(sub(xyz(c1.eval({phi})), a)), norm(sub(xyz(c2.eval({phi})), b))});
+      }
+    if (worst <= tol) break;
+    if (round >= std::max(1, blend.max_rounds))
+      throw Error("fillet corner at " + at(f.o) + ": the section's control points do not reach the tolerance " +
+                      num(tol) + " (" + num(worst) + ")",
+                  ErrorKind::failed);
+    kv = halved(kv);
+    rail = spline::to_space(rail, 0, kv);
+  }
+  qa.bd_samples[1] = kv.size();
+  const int n = kv.size();
+  std::vector<double> pts(static_cast<std::size_t>(n) * 4 * 3);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < n; ++i) {
+      Vec x;
+      if ((j == 0 && g == 0) || (j == 3 && g == 1)) x = xyz(rail.point(i).data());
+      else if (j == 0 || j == 3) x = r;
+      else x = xyz((j == 1 ? c1 : c2).point(i).data());
+      std::copy(x.begin(), x.end(), pts.begin() + 3 * (i + n * j));
+    }
+  const Surface sb({kv, KnotVector::bezier(4)}, 3, std::move(pts));
+  const auto halves = g == 0 ? ruled_fillet(fan, seg, sb) : ruled_fillet(seg, fan, sb);
+  out.cells = halves;
+  // Quality.
+  qa.end_error = std::max(norm(sub(xyz(rail.eval({0.0})), p)), norm(sub(xyz(rail.eval({1.0})), q)));
+  const Curve at_o = spline::coordinates(spline::iso(fan, 1, g == 0 ? 1.0 : 0.0), 0, 3);
+  const Curve at_r = spline::coordinates(spline::iso(sb, 1, g == 0 ? 1.0 : 0.0), 0, 3);
+  for (int a = 0; a <= 256; ++a) {
+    const double phi = a / 256.0;
+    const Vec b = xyz(rail.eval({phi}));
+    qa.radius_error = std::max(qa.radius_error, std::abs(norm(sub(b, f.o)) - ((1 - phi) * f.dp + phi * f.dq)));
+    qa.o_error = std::max(qa.o_error, norm(sub(xyz(at_o.eval({phi})), f.o)));
+    qa.r_error = std::max(qa.r_error, norm(sub(xyz(at_r.eval({phi})), r)));
+    // G1 along B_d: S_b's normal there against S_g's.
+    const auto uv = bd.eval({phi});
+    const double vb = g == 0 ? 0.0 : 1.0;
+    const auto d = sb.eval_derivatives({phi, vb}, 1);
+    const Vec nb = cross(xyz(d.data() + 3), xyz(d.data() + 6));
+    if (norm(nb) > 1e-12 * std::max(1.0, norm(xyz(d.data() + 3)) * norm(xyz(d.data() + 6)))) {
+      const double cs = std::abs(dot(unit(nb), normal_at(s, {uv[0], uv[1]})));
+      qa.g1_angle = std::max(qa.g1_angle, std::acos(std::min(1.0, cs)));
+    }
+  }
+  qa.det_min = std::numeric_limits<double>::infinity();
+  qa.det_max = -qa.det_min;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const auto rg = det_range(out.cells[c]);
+    qa.cell_jacobian[c] = rg;
+    qa.det_min = std::min(qa.det_min, rg[0]);
+    qa.det_max = std::max(qa.det_max, rg[1]);
+    qa.cell_volume[c] = std::abs(boundary_volume(out.cells[c]));
+  }
+  qa.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+namespace {
+
+/// Largest xyz distance between two faces at the same relative parameters (13 x 13 samples).
+double face_gap(const Surface& a, const Surface& b) {
+  double worst = 0.0;
+  constexpr int n = 12;
+  const auto au = a.domain(0), av = a.domain(1), bu = b.domain(0), bv = b.domain(1);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const double s = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
+      const Vec x = xyz(a.eval({au[0] + (au[1] - au[0]) * s, av[0] + (av[1] - av[0]) * t}));
+      const Vec y = xyz(b.eval({bu[0] + (bu[1] - bu[0]) * s, bv[0] + (bv[1] - bv[0]) * t}));
+      worst = std::max(worst, norm(sub(x, y)));
+    }
+  return worst;
+}
+
+Vec eval3(const Surface& s, const Curve& c, double t, Vec* tangent = nullptr) {
+  const auto cd = c.eval_derivatives({t}, 1);
+  const auto d = s.eval_derivatives({cd[0], cd[1]}, 1);
+  const std::size_t k = static_cast<std::size_t>(s.dim());
+  if (tangent) *tangent = axpy(scale(xyz(d.data() + k), cd[2]), cd[3], xyz(d.data() + 2 * k));
+  return xyz(d.data());
+}
+
+std::string piece_name(const FilletPiece& p, const std::vector<SideFace>& s1, const std::vector<SideFace>& s2) {
+  return s1[p.face[0]].name + " x " + s2[p.face[1]].name;
+}
+
+}  // namespace
+
+MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<SideFace>& side2,
+                          const FilletOptions& o, const CornerOptions& co) {
+  if (side1.empty() || side2.empty()) throw Error("fillet across faces: a side without faces; expected at least one face each");
+  const std::array<const std::vector<SideFace>*, 2> sides{&side1, &side2};
+  double diag = 0.0;
+  {
+    std::array<double, 3> lo, hi;
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (const auto* side : sides)
+      for (const SideFace& sf : *side) {
+        if (sf.cell == nullptr) throw Error("fillet across faces: " + sf.name + " has no cell");
+        const auto b = spline::bounding_box(*sf.cell, 3);
+        for (std::size_t j = 0; j < 3; ++j) lo[j] = std::min(lo[j], b[0][j]), hi[j] = std::max(hi[j], b[1][j]);
+      }
+    diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  }
+  FilletOptions fo = o;
+  if (!(fo.tolerance > 0.0)) fo.tolerance = 1e-7 * diag;
+  if (fo.construction != Construction::ruled)
+    throw Error("fillet across faces: construction " + std::string(construction_name(fo.construction)) +
+                "; expected \"ruled\" (seed 000 Sec. 6 here joins ruled fillets, Alg. 2)");
+  const double tol = fo.tolerance;
+  const double jt = co.join_tolerance > 0.0 ? co.join_tolerance
+                                            : std::max(100.0 * tol, 1e-4 * std::min(fo.distance[0], fo.distance[1]));
+  MultiFillet out;
+  // Step 1: the pairs that cross along a curve, one fillet per component (Sec. 6).
+  std::vector<FilletPiece> pieces;
+  geom::IntersectionOptions io;
+  io.tolerance = tol;
+  for (std::size_t i = 0; i < side1.size(); ++i) {
+    const Surface s1 = spline::boundary_face(*side1[i].cell, side1[i].face);
+    for (std::size_t j = 0; j < side2.size(); ++j) {
+      const Surface s2 = spline::boundary_face(*side2[j].cell, side2[j].face);
+      const auto curves = geom::intersect_surfaces(s1, s2, io);
+      if (std::none_of(curves.begin(), curves.end(), [](const auto& c) { return c.points.size() > 1; })) continue;
+      std::vector<Fillet> fs;
+      try {
+        fs = fillet_faces(*side1[i].cell, side1[i].face, *side2[j].cell, side2[j].face, fo);
+      } catch (const Error& e) {
+        throw e.within("fillet between " + side1[i].name + " and " + side2[j].name);
+      }
+      // Group by component.
+      for (auto& fl : fs) {
+        if (pieces.empty() || pieces.back().face != std::array<std::size_t, 2>{i, j} ||
+            pieces.back().fillets.front().component != fl.component) {
+          FilletPiece p;
+          p.face = {i, j};
+          const RailPair& rp = fl.rails;
+          p.closed = rp.closed;
+          for (int e = 0; e < 2; ++e) {
+            const double t = e;
+            auto& end = p.ends[static_cast<std::size_t>(e)];
+            end.o = eval3(s1, rp.rails[0].base, t, &end.tangent);
+            const Surface* faces[2] = {&s1, &s2};
+            for (std::size_t k = 0; k < 2; ++k) {
+              const auto b = rp.rails[k].base.eval({t}), rr = rp.rails[k].rail.eval({t});
+              end.o_uv[k] = {b[0], b[1]};
+              end.rail_uv[k] = {rr[0], rr[1]};
+              end.rail[k] = point_at(*faces[k], end.rail_uv[k]);
+            }
+          }
+          pieces.push_back(std::move(p));
+        }
+        pieces.back().fillets.push_back(std::move(fl));
+      }
+    }
+  }
+  if (pieces.empty()) {
+    std::string list1, list2;
+    for (const auto& s : side1) list1 += (list1.empty() ? "" : ", ") + s.name;
+    for (const auto& s : side2) list2 += (list2.empty() ? "" : ", ") + s.name;
+    throw Error("fillet across faces: the faces " + list1 + " and " + list2 +
+                " do not intersect; expected faces that cross along a curve");
+  }
+  // Chain the pieces at their ends.
+  const std::size_t np = pieces.size();
+  std::vector<std::array<long, 2>> mate(np, {-1, -1});  // mate[p][e] = 2 * piece + end
+  for (std::size_t a = 0; a < np; ++a)
+    for (int ea = 0; ea < 2; ++ea) {
+      if (pieces[a].closed) continue;
+      for (std::size_t b = a + 1; b < np; ++b)
+        for (int eb = 0; eb < 2; ++eb) {
+          if (pieces[b].closed) continue;
+          if (norm(sub(pieces[a].ends[static_cast<std::size_t>(ea)].o, pieces[b].ends[static_cast<std::size_t>(eb)].o)) > jt)
+            continue;
+          for (const auto& [x, ex] : {std::pair{a, ea}, std::pair{b, eb}})
+            if (mate[x][static_cast<std::size_t>(ex)] >= 0)
+              throw Error("fillet across faces: three or more pieces of C meet at " +
+                          at(pieces[x].ends[static_cast<std::size_t>(ex)].o) + " (" + piece_name(pieces[x], side1, side2) +
+                          " among them); expected a curve C whose pieces meet in pairs (seed 000 Sec. 6)");
+          mate[a][static_cast<std::size_t>(ea)] = static_cast<long>(2 * b + static_cast<std::size_t>(eb));
+          mate[b][static_cast<std::size_t>(eb)] = static_cast<long>(2 * a + static_cast<std::size_t>(ea));
+        }
+    }
+  // Walk: from the first piece with a free end (an open chain), else piece 0; each piece entered
+  // at one end leaves at the other. Pieces in other chains follow in their own walks.
+  std::vector<bool> used(np, false);
+  std::vector<std::size_t> order;
+  std::vector<Junction> junctions;
+  int chains = 0;
+  bool any_open = false;
+  while (order.size() < np) {
+    std::size_t startp = np;
+    int enter = 0;
+    for (std::size_t a = 0; a < np && startp == np; ++a)
+      if (!used[a])
+        for (int e = 0; e < 2; ++e)
+          if (mate[a][static_cast<std::size_t>(e)] < 0 && !pieces[a].closed) {
+            startp = a, enter = e;
+            break;
+          }
+    if (startp == np)
+      for (std::size_t a = 0; a < np; ++a)
+        if (!used[a]) {
+          startp = a;
+          break;
+        }
+    ++chains;
+    std::size_t cur = startp;
+    int in_end = enter;
+    while (true) {
+      used[cur] = true;
+      order.push_back(cur);
+      const int out_end = 1 - in_end;
+      if (pieces[cur].closed) break;
+      const long m = mate[cur][static_cast<std::size_t>(out_end)];
+      if (m < 0) {
+        any_open = true;
+        break;
+      }
+      const std::size_t nxt = static_cast<std::size_t>(m / 2);
+      const int ne = static_cast<int>(m % 2);
+      Junction jn;
+      jn.piece = {cur, nxt};  // input indices; chain indices below
+      jn.end = {out_end, ne};
+      junctions.push_back(jn);
+      if (used[nxt]) break;  // closed the loop
+      cur = nxt;
+      in_end = ne;
+    }
+  }
+  out.closed = chains == 1 && !any_open && !pieces[order.front()].closed;
+  // Re-index pieces in chain order.
+  std::vector<std::size_t> pos(np);
+  for (std::size_t k = 0; k < np; ++k) pos[order[k]] = k;
+  for (std::size_t k = 0; k < np; ++k) out.pieces.push_back(std::move(pieces[order[k]]));
+  // Classify the junctions (file comment).
+  for (Junction& jn : junctions) {
+    jn.piece = {pos[jn.piece[0]], pos[jn.piece[1]]};
+    const FilletPiece& pa = out.pieces[jn.piece[0]];
+    const FilletPiece& pb = out.pieces[jn.piece[1]];
+    const auto& ea = pa.ends[static_cast<std::size_t>(jn.end[0])];
+    const auto& eb = pb.ends[static_cast<std::size_t>(jn.end[1])];
+    const Vec ta = unit(jn.end[0] == 1 ? ea.tangent : scale(ea.tangent, -1.0));
+    const Vec tb = unit(jn.end[1] == 0 ? eb.tangent : scale(eb.tangent, -1.0));
+    jn.o = scale(axpy(ea.o, 1.0, eb.o), 0.5);
+    jn.angle = std::acos(std::clamp(dot(ta, tb), -1.0, 1.0));
+    const std::string where = "fillet corner at " + at(jn.o) + " between " + piece_name(pa, side1, side2) + " and " +
+                              piece_name(pb, side1, side2);
+    std::array<bool, 2> meet{};
+    for (std::size_t s = 0; s < 2; ++s) {
+      jn.rail_gap[s] = norm(sub(ea.rail[s], eb.rail[s]));
+      meet[s] = jn.rail_gap[s] <= jt;
+    }
+    if ((meet[0] && meet[1]) || jn.angle <= co.smooth_angle) {
+      jn.kind = JunctionKind::smooth;
+      continue;
+    }
+    if (!meet[0] && !meet[1])
+      throw Error(where + ": the rails meet on neither body (gaps " + num(norm(sub(ea.rail[0], eb.rail[0]))) + " and " +
+                  num(norm(sub(ea.rail[1], eb.rail[1]))) +
+                  "); expected an edge of one body only, perpendicular to the other body's face there (seed 000 "
+                  "Sec. 6.1; clipping rails at a slanted edge is not supported)");
+    const int g = meet[0] ? 1 : 0;
+    const std::size_t gs = static_cast<std::size_t>(g);
+    jn.kind = JunctionKind::corner;
+    jn.gap_side = g;
+    jn.p = ea.rail[gs];
+    jn.q = eb.rail[gs];
+    jn.r = scale(axpy(ea.rail[1 - gs], 1.0, eb.rail[1 - gs]), 0.5);
+    const Vec pq = sub(jn.q, jn.p);
+    const double sa = dot(pq, ta), sb = dot(pq, tb);
+    if (sa < 0.0 && sb < 0.0)
+      throw Error(where + ": a concave corner (the rails on " + (*sides[gs])[pa.face[gs]].name +
+                  " cross); expected convex corners (seed 000 Sec. 6 leaves concave C1 discontinuities to future work)");
+    if (!(sa > 0.0 && sb > 0.0))
+      throw Error(where + ": the rails' ends p " + at(jn.p) + " and q " + at(jn.q) +
+                  " are neither apart nor crossing; expected a convex corner");
+    if (pa.face[gs] != pb.face[gs])
+      throw Error(where + ": the gap lies on two faces (" + (*sides[gs])[pa.face[gs]].name + " and " +
+                  (*sides[gs])[pb.face[gs]].name + "); expected the corner inside one face of the smooth body");
+    const double d = fo.distance[gs];
+    if (std::abs(norm(sub(jn.p, jn.o)) - d) > jt || std::abs(norm(sub(jn.q, jn.o)) - d) > jt)
+      throw Error(where + ": the rails end " + num(norm(sub(jn.p, jn.o))) + " and " + num(norm(sub(jn.q, jn.o))) +
+                  " from the corner; expected " + num(d));
+  }
+  out.junctions = std::move(junctions);
+  if (!co.bridge) return out;
+  // Step 2: the bridging fillets (Sec. 6.1).
+  for (std::size_t jidx = 0; jidx < out.junctions.size(); ++jidx) {
+    const Junction& jn = out.junctions[jidx];
+    if (jn.kind != JunctionKind::corner) continue;
+    const FilletPiece& pa = out.pieces[jn.piece[0]];
+    const FilletPiece& pb = out.pieces[jn.piece[1]];
+    const auto& ea = pa.ends[static_cast<std::size_t>(jn.end[0])];
+    const auto& eb = pb.ends[static_cast<std::size_t>(jn.end[1])];
+    const std::size_t gs = static_cast<std::size_t>(jn.gap_side), hs = 1 - gs;
+    const SideFace& fg = (*sides[gs])[pa.face[gs]];
+    const SideFace& fh = (*sides[hs])[pa.face[hs]];
+    const Surface sg = spline::boundary_face(*fg.cell, fg.face), sh = spline::boundary_face(*fh.cell, fh.face);
+    CornerInput ci;
+    ci.face = &sg;
+    ci.gap_side = jn.gap_side;
+    ci.o_uv = ea.o_uv[gs];
+    ci.p_uv = ea.rail_uv[gs];
+    ci.q_uv = eb.rail_uv[gs];
+    ci.meet = &sh;
+    ci.meet_o_uv = ea.o_uv[hs];
+    ci.meet_r_uv = ea.rail_uv[hs];
+    SubregionOptions so;
+    so.method = fo.method;
+    CornerFillet cf;
+    try {
+      cf = bridge_corner(ci, fo.blend, tol, so);
+    } catch (const Error& e) {
+      throw e.within("fillet corner at " + at(jn.o) + " between " + piece_name(pa, side1, side2) + " and " +
+                     piece_name(pb, side1, side2));
+    }
+    cf.junction = jidx;
+    // C0 glue: the bridge's end faces against the neighbours' end faces at the same (v, w),
+    // cell for cell (both are ruled halves: v from the rail to C, w from S^_i to S_b); the
+    // pair of ends (u0 or u1 of each) that fits best is the junction.
+    for (std::size_t side = 0; side < 2; ++side) {
+      const FilletPiece& nb = side == 0 ? pa : pb;
+      double best = std::numeric_limits<double>::infinity();
+      for (const Fillet& fl : nb.fillets)
+        for (spline::Face fn : {spline::Face::u0, spline::Face::u1})
+          for (spline::Face fb : {spline::Face::u0, spline::Face::u1})
+            best = std::min(best, std::max(face_gap(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn)),
+                                           face_gap(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn))));
+      cf.quality.glue[side] = best;
+    }
+    out.corners.push_back(std::move(cf));
+  }
+  return out;
+}
+
+}  // namespace trivox::fillet

@@ -1,0 +1,124 @@
+#!/usr/bin/env bash
+# End-to-end: fillets over several faces with C1 corners (seed 000 Sec. 6) and the singular
+# bridging fillets at the convex corners (Sec. 6.1), built by `trivox build`. Truths:
+# - a column [-1,1]^2 x [-1,3] through a plate z <= 0 (boxes): C is the square footprint, four
+#   straight pieces and four convex corners at the column's vertical edges. The pieces are the
+#   Hermite section swept along 2 mm each, the bridges the section turned a quarter turn about the
+#   edge (Pappus: (pi/2) oint X^2/2 dZ, tests/cli/fillet_math.py), so the ring's volume is exact;
+#   a point by an edge, outside both boxes and inside the ring's corner, is in a bridge cell with
+#   the bridges and in no cell with "corners": "open" (the gap of Fig. 12 (c));
+# - the box and cylinder of Fig. 12 (models/box_cylinder.json): a cylinder of radius 8 whose axis
+#   lies in the box's face x = 0, through its top and bottom faces: C has eight pieces (three
+#   cylinder cells' sides against three box faces) and four convex corners at (0, +-8, 0) and
+#   (0, +-8, -10), where the box's edges (along y, perpendicular to the cylinder there) cross
+#   the cylinder; p and q are 2 from o on the cylinder, r = o +- (0, 2, 0) on the edge; det J > 0
+#   inside; the bridges glue to their neighbours within the fit tolerance;
+# - bad input exits 2 naming the place: a concave corner (the plate's rails flipped into the
+#   footprint cross), faces that do not meet, "corners" without face lists, the flend section or
+#   the VBS construction with corners, a bad face name in a list.
+set -euo pipefail
+source tests/cli/lib.bash "$@"
+
+column_scene() {  # column_scene FILE EXTRA-FIELDS [SIDE-2]: the column's four sides by default
+  local side2=${3:-'{"cell": "column", "face": "u0"}, {"cell": "column", "face": "v0"},
+                 {"cell": "column", "face": "u1"}, {"cell": "column", "face": "v1"}'}
+  cat > "$1" <<EOF
+{ "trivox": 1, "units": "mm", "properties": ["r", "g", "b"],
+  "cells": [
+    {"name": "plate", "primitive": {"type": "box", "min": [-4, -4, -2], "max": [4, 4, 0]}, "field": {"constant": [1, 0, 0]}},
+    {"name": "column", "primitive": {"type": "box", "min": [-1, -1, -1], "max": [1, 1, 3]}, "field": {"constant": [0, 0, 1]}}
+  ],
+  "operations": [{"op": "fillet", "name": "ring",
+    "between": [[{"cell": "plate", "face": "w1"}],
+                [$side2]],
+    "distance": [1.0, 0.5], "tau": 1.0$2}] }
+EOF
+}
+
+column_scene "$tmp/column.json" ""
+"$trivox" build "$tmp/column.json" -o "$tmp/column.model.json" --json > "$tmp/column.build.json"
+"$py" - "$tmp/column.build.json" <<'PY'
+import sys, json, math
+sys.path.insert(0, "tests/cli")
+from fillet_math import hermite_area, hermite_moment
+r = json.load(open(sys.argv[1]))
+assert r["valid"], "every cell valid"
+d1, d2, tau = 1.0, 0.5, 1.0
+f, k = r["fillets"], r["corners"]
+assert len(f) == 4 and len(k) == 4, (len(f), len(k))
+for c in k:
+    o, p, q, rr = (c[x] for x in "opqr")
+    assert abs(abs(o[0]) - 1) < 1e-9 and abs(abs(o[1]) - 1) < 1e-9 and abs(o[2]) < 1e-9, o
+    assert abs(math.dist(o, p) - d1) < 1e-9 and abs(math.dist(o, q) - d1) < 1e-9, (o, p, q)
+    assert math.dist(rr, [o[0], o[1], o[2] + d2]) < 1e-9, (o, rr)
+    assert abs(c["angle"] - math.pi / 2) < 1e-9, c["angle"]
+    assert c["gap_face"] == "plate/w1" and c["edge_face"].startswith("column/"), c
+    assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
+    assert max(c["glue"]) < 1e-5 and c["g1_angle"] < 1e-5, (c["glue"], c["g1_angle"])
+vol = {x["name"]: x["volume"] for x in r["cells"]}
+pieces = sum(v for n, v in vol.items() if n.startswith("ring.") and not n.startswith("ring.c"))
+bridges = sum(v for n, v in vol.items() if n.startswith("ring.c"))
+want_p = 4 * 2.0 * hermite_area(d1, d2, tau)
+want_b = 4 * math.pi / 2 * hermite_moment(d1, d2, tau)
+assert abs(pieces - want_p) < 1e-9 * want_p, (pieces, want_p)
+assert abs(bridges - want_b) < 1e-5 * want_b, (bridges, want_b)
+print(f"column ring: pieces {pieces:.9f} (exact {want_p:.9f}), bridges {bridges:.9f} (Pappus {want_b:.9f})")
+PY
+# By the edge x = y = 1: 0.2 out along the diagonal and 0.1 up lies in the bridge, and in the
+# gap without it.
+loc() { "$trivox" locate "$1" --xyz "$2" --json | "$py" -c 'import sys, json; d = json.load(sys.stdin); print(d["cell"] if d["inside"] else "-")'; }
+cell=$(loc "$tmp/column.model.json" 1.1414,1.1414,0.1)
+case $cell in ring.c*) ;; *) echo "by the edge: in '$cell', expected a bridge cell ring.c*"; exit 1 ;; esac
+column_scene "$tmp/open.json" ', "corners": "open"'
+"$trivox" build "$tmp/open.json" -o "$tmp/open.model.json" --json > "$tmp/open.build.json"
+cell=$(loc "$tmp/open.model.json" 1.1414,1.1414,0.1)
+[ "$cell" = - ] || { echo "open corners: the gap point is in '$cell'"; exit 1; }
+"$py" -c 'import sys, json; r = json.load(open(sys.argv[1])); assert r["corners"] == [] and len(r["fillets"]) == 4' "$tmp/open.build.json"
+
+# Fig. 12: the box and the cylinder.
+"$trivox" build models/box_cylinder.json -o "$tmp/bc.model.json" --json > "$tmp/bc.build.json"
+"$py" - "$tmp/bc.build.json" <<'PY'
+import sys, json, math
+r = json.load(open(sys.argv[1]))
+assert r["valid"], "every cell valid"
+f, k = r["fillets"], r["corners"]
+assert len(f) == 8 and len(k) == 4, (len(f), len(k))
+for x in f:
+    assert x["jacobian"] == "positive", (x["between"], x["jacobian"])
+    assert max(x["gap"]) < 1e-4 and max(x["g1_angle"]) < 1e-3, (x["between"], x["gap"], x["g1_angle"])
+seen = set()
+for c in k:
+    o, p, q, rr = (c[x] for x in "opqr")
+    # The cylinder is the cubic interpolant of the circle, within 2e-4 r (construct/primitives.hpp).
+    assert abs(o[0]) < 1e-5 and abs(abs(o[1]) - 8) < 2e-3 and min(abs(o[2]), abs(o[2] + 10)) < 1e-5, o
+    seen.add((round(o[1]), round(o[2])))
+    assert abs(math.dist(o, p) - 2) < 1e-4 and abs(math.dist(o, q) - 2) < 1e-4, (o, p, q)
+    assert math.dist(rr, [0, o[1] + math.copysign(2, o[1]), o[2]]) < 1e-4, (o, rr)
+    assert c["gap_face"].startswith("post.y") and c["edge_face"].startswith("block/"), c
+    assert abs(c["angle"] - math.pi / 2) < 1e-2, c["angle"]
+    assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
+    assert max(c["end_error"], c["o_error"], c["r_error"], c["radius_error"]) < 1e-4, c
+    assert max(c["glue"]) < 1e-4 and c["g1_angle"] < 1e-3, (c["glue"], c["g1_angle"])
+    print(f"corner {o[0]:+.4f} {o[1]:+.4f} {o[2]:+.4f}: glue {max(c['glue']):.2e}, G1 {c['g1_angle']:.2e}, "
+          f"det J {c['min_jacobian']:.3e}..{c['max_jacobian']:.3e}, volume {sum(c['cell_volume']):.6f}")
+assert seen == {(8, 0), (-8, 0), (8, -10), (-8, -10)}, seen
+PY
+# Next to the corner (0, 8, 0), outside the box (x > 0, z > 0) and the cylinder: in a bridge.
+cell=$(loc "$tmp/bc.model.json" 0.3,8.3,0.3)
+case $cell in ring.c*) ;; *) echo "by the corner (0, 8, 0): in '$cell', expected a bridge cell ring.c*"; exit 1 ;; esac
+
+# Bad input: exit 2, the place named.
+column_scene "$tmp/bad.json" ', "flip": [true, false]'
+expect_fail '/operations/0: fillet corner at (.*concave corner' "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+column_scene "$tmp/bad.json" "" '{"cell": "column", "face": "w1"}, {"cell": "column", "face": "w0"}'
+expect_fail '/operations/0: fillet across faces: the faces plate/w1 and column/w1, column/w0 do not intersect' \
+  "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+corner_scene "$tmp/bad.json" "$(fillet_op '"distance": 1, "corners": "bridge"')"
+expect_fail '/operations/0/corners: "corners" with one face per side' "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+column_scene "$tmp/bad.json" ', "section": "flend"'
+expect_fail '/operations/0/section: .*Hermite section' "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+column_scene "$tmp/bad.json" ', "construction": "vbs"'
+expect_fail '/operations/0/construction: "construction" with a fillet over several faces' "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+sed 's/"face": "v1"/"face": "side"/' "$tmp/column.json" > "$tmp/bad.json"
+expect_fail '/operations/0/between/1/3/face: unknown face "side"' "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+echo "corner_fillets: ok"

@@ -1,0 +1,168 @@
+// Seed 000 Sec. 6 / 6.1 (fillet/corners.hpp): a column standing through a plate. C is the
+// column's square footprint, four straight pieces C_{w1,j} meeting at four convex corners where
+// the column's vertical edges (perpendicular to the plate) cross the plate. Expected values from
+// the geometry: the column's rails meet on its edges at r = o + d2 z, the plate's rails end at
+// distance d1 from o; each piece's fillet is the Hermite section swept along a straight line of
+// length 2, and each bridge is that section revolved a quarter turn about the edge (the plate is
+// a plane and the edge its normal), so its volume is Pappus' (pi/2) int X dA = (pi/2) oint X^2/2 dZ.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+#include "corner.hpp"
+#include "trivox/error.hpp"
+#include "trivox/fillet/corners.hpp"
+
+using fillet_test::box_cell;
+using fillet_test::hermite_area;
+using trivox::Error;
+namespace fillet = trivox::fillet;
+namespace spline = trivox::spline;
+
+namespace {
+
+/// int over the region between the legs and the Hermite section of X dA (X the distance from
+/// the Z axis, the edge): by Green's theorem oint X^2 / 2 dZ, only the section contributes;
+/// exact with 8 Gauss points (degree 8 integrand).
+double hermite_moment(double d1, double d2, double tau) {
+  const double w = tau * std::hypot(d1, d2);
+  const double P[4][2] = {{d1, 0}, {d1 - w / 3, 0}, {0, d2 - w / 3}, {0, d2}};
+  const trivox::geom::GaussRule g = trivox::geom::gauss_legendre(8);
+  double m = 0.0;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    const double t = 0.5 * (g.nodes[i] + 1), s = 1 - t;
+    const double B[4] = {s * s * s, 3 * t * s * s, 3 * t * t * s, t * t * t};
+    const double dB[4] = {-3 * s * s, 3 * s * s - 6 * t * s, 6 * t * s - 3 * t * t, 3 * t * t};
+    double X = 0, dZ = 0;
+    for (int j = 0; j < 4; ++j) X += B[j] * P[j][0], dZ += dB[j] * P[j][1];
+    m += 0.5 * g.weights[i] * 0.5 * X * X * dZ;
+  }
+  return m;
+}
+
+double dist(const std::array<double, 3>& a, const std::vector<double>& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+struct Column {
+  spline::Trivariate plate = box_cell({-4, -4, -2}, {4, 4, 0}, 1.0);
+  spline::Trivariate column = box_cell({-1, -1, -1}, {1, 1, 3}, 2.0);
+  std::vector<fillet::SideFace> side1{{&plate, spline::Face::w1, "plate/w1"}};
+  std::vector<fillet::SideFace> side2{{&column, spline::Face::u0, "column/u0"},
+                                      {&column, spline::Face::v1, "column/v1"},
+                                      {&column, spline::Face::u1, "column/u1"},
+                                      {&column, spline::Face::v0, "column/v0"}};
+};
+
+}  // namespace
+
+TEST_CASE("fillet across a column's faces: Sec. 6 pieces and Sec. 6.1 bridges at the convex corners", "[fillet][corners]") {
+  Column c;
+  fillet::FilletOptions o;
+  const double d1 = 1.0, d2 = 0.5, tau = 1.0;
+  o.distance = {d1, d2};
+  o.blend.tau = tau;
+  const auto m = fillet::fillet_across(c.side1, c.side2, o);
+  REQUIRE(m.pieces.size() == 4);
+  CHECK(m.closed);
+  REQUIRE(m.junctions.size() == 4);
+  REQUIRE(m.corners.size() == 4);
+  const double area = hermite_area(d1, d2, tau);
+  const double bridge_volume = std::numbers::pi / 2 * hermite_moment(d1, d2, tau);
+  double pieces_volume = 0.0, total = 0.0;
+  for (const auto& p : m.pieces) {
+    REQUIRE(p.fillets.size() == 1);
+    double v = 0.0;
+    for (double x : p.fillets[0].quality.cell_volume) v += x;
+    CHECK(v == Approx(2.0 * area).epsilon(1e-9));  // the section along a segment of length 2
+    pieces_volume += v;
+  }
+  for (const auto& j : m.junctions) {
+    CHECK(j.kind == fillet::JunctionKind::corner);
+    CHECK(j.gap_side == 0);  // the plate is smooth at o; the column has the edge
+    CHECK(j.angle == Approx(std::numbers::pi / 2).epsilon(1e-9));
+    CHECK(std::abs(std::abs(j.o[0]) - 1) < 1e-9);
+    CHECK(std::abs(std::abs(j.o[1]) - 1) < 1e-9);
+    CHECK(std::abs(j.o[2]) < 1e-9);
+    CHECK(std::hypot(j.r[0] - j.o[0], j.r[1] - j.o[1], j.r[2] - j.o[2] - d2) < 1e-9);
+    CHECK(std::hypot(j.p[0] - j.o[0], j.p[1] - j.o[1], j.p[2] - j.o[2]) == Approx(d1).epsilon(1e-9));
+    CHECK(std::hypot(j.q[0] - j.o[0], j.q[1] - j.o[1], j.q[2] - j.o[2]) == Approx(d1).epsilon(1e-9));
+  }
+  const double tol = 1e-7 * std::sqrt(8 * 8 + 8 * 8 + 5 * 5);  // fillet_faces' default
+  for (const auto& cf : m.corners) {
+    const auto& q = cf.quality;
+    const auto& j = m.junctions[cf.junction];
+    INFO("corner at " << j.o[0] << ", " << j.o[1]);
+    CHECK(q.jacobian() == "positive");
+    CHECK(q.det_min > 0.0);
+    CHECK(q.end_error < 1e-9);  // the rail interpolates p and q
+    CHECK(q.o_error < 1e-9);    // the fan collapses onto o
+    CHECK(q.r_error < 1e-9);    // the section ends at r
+    CHECK(q.radius_error < tol);
+    CHECK(q.g1_angle < 1e-5);
+    CHECK(q.glue[0] < 10 * tol);  // C0 with both neighbours
+    CHECK(q.glue[1] < 10 * tol);
+    const double v = q.cell_volume[0] + q.cell_volume[1];
+    CHECK(v == Approx(bridge_volume).epsilon(1e-5));
+    total += v;
+    // The fan's corners: p and q at the rail (v = 0, w = 0) ends, o at v = 1; properties g_1 = 1
+    // on the plate's sub-region and g_2 = 2 on the column's.
+    const auto& h0 = cf.cells[0];
+    const auto du = h0.domain(0);
+    const auto a = h0.eval({du[0], 0.0, 0.0}), b = h0.eval({du[1], 0.0, 0.0});
+    CHECK(std::min(dist(j.p, a), dist(j.q, a)) < 1e-9);
+    CHECK(std::min(dist(j.p, b), dist(j.q, b)) < 1e-9);
+    CHECK(dist(j.p, a) + dist(j.p, b) > d1);  // one of each
+    CHECK(dist(j.o, h0.eval({0.5 * (du[0] + du[1]), 1.0, 0.0})) < 1e-9);
+    CHECK(h0.eval({0.3, 0.4, 0.0})[3] == Approx(1.0).epsilon(1e-12));
+    CHECK(cf.cells[1].eval({0.3, 0.4, 0.0})[3] == Approx(2.0).epsilon(1e-12));
+    // The column's side is the edge segment o r: singular by construction.
+    CHECK(dist(j.r, cf.cells[1].eval({0.7, 1.0, 0.0})) < 1e-9);
+  }
+  // The whole fillet ring: four sweeps and four quarter revolutions.
+  CHECK(pieces_volume + total == Approx(4 * 2.0 * area + 4 * bridge_volume).epsilon(1e-5));
+}
+
+TEST_CASE("fillet across faces: gaps left open without bridges (Fig. 12 (c))", "[fillet][corners]") {
+  Column c;
+  fillet::FilletOptions o;
+  o.distance = {1.0, 0.5};
+  fillet::CornerOptions co;
+  co.bridge = false;
+  const auto m = fillet::fillet_across(c.side1, c.side2, o, co);
+  CHECK(m.pieces.size() == 4);
+  CHECK(m.junctions.size() == 4);
+  CHECK(m.corners.empty());
+}
+
+TEST_CASE("fillet across faces: bad input names the place", "[fillet][corners]") {
+  Column c;
+  fillet::FilletOptions o;
+  o.distance = {1.0, 0.5};
+  SECTION("a concave corner: the plate's rails inside the footprint cross") {
+    o.flip = {true, false};
+    try {
+      (void)fillet::fillet_across(c.side1, c.side2, o);
+      FAIL("no error");
+    } catch (const Error& e) {
+      CHECK(e.kind() == trivox::ErrorKind::bad_input);
+      CHECK_THAT(e.what(), Catch::Contains("concave corner") && Catch::Contains("plate/w1 x column/") &&
+                               Catch::Contains("fillet corner at ("));
+    }
+  }
+  SECTION("faces that do not meet") {
+    const std::vector<fillet::SideFace> top{{&c.column, spline::Face::w1, "column/w1"}};
+    try {
+      (void)fillet::fillet_across(c.side1, top, o);
+      FAIL("no error");
+    } catch (const Error& e) {
+      CHECK(e.kind() == trivox::ErrorKind::bad_input);
+      CHECK_THAT(e.what(), Catch::Contains("plate/w1 and column/w1 do not intersect"));
+    }
+  }
+  SECTION("the flend section has no bridge") {
+    o.blend.section = fillet::Section::flend;
+    CHECK_THROWS_WITH(fillet::fillet_across(c.side1, c.side2, o), Catch::Contains("Hermite section"));
+  }
+}
