@@ -111,7 +111,7 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                     {"volume", q[i].volume}});
       continue;
     }
-    const bool ok = r.verdict == geom::Validity::valid;
+    const bool ok = r.verdict == geom::Validity::valid || r.verdict == geom::Validity::degenerate;
     valid = valid && (ok || !q[i].checked);
     total += q[i].volume;
     jc.push_back({{"name", cells[i].name},

@@ -18,7 +18,7 @@ struct Options {
 void add_validate(CLI::App& app, Common& common) {
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
-      "validate", "Jacobian validity per cell: bounds of the determinant, first invalid location (exit 1 if any is not valid)");
+      "validate", "Jacobian validity per cell: bounds of the determinant, first invalid location, degenerate boundaries (exit 1 if any is not valid)");
   sub->add_option("MODEL", opt->model, "Model file (.json, or G+Smo .xml)")->required();
   sub->add_flag("--json", common.json, "Print one JSON object instead of the summary");
   sub->callback([opt, &common] {
@@ -34,7 +34,9 @@ void add_validate(CLI::App& app, Common& common) {
       } catch (const Error& e) {
         throw e.within(opt->model + ": cell " + c.name);
       }
-      const bool valid = r.verdict == geom::Validity::valid;
+      // A degenerate boundary (det J = 0 there by construction: fillet rails, apexes) leaves the
+      // open cell a valid parametrisation: it counts as valid, and is reported as such.
+      const bool valid = r.verdict == geom::Validity::valid || r.verdict == geom::Validity::degenerate;
       all_valid = all_valid && valid;
       nlohmann::ordered_json j = {{"name", c.name},
                                   {"valid", valid},
@@ -45,7 +47,16 @@ void add_validate(CLI::App& app, Common& common) {
                                   {"min_evaluated", r.min_seen},
                                   {"max_evaluated", r.max_seen},
                                   {"pieces", r.pieces}};
-      std::string where;
+      std::string where, degenerate;
+      if (r.degenerate_at) {
+        const auto& t = *r.degenerate_at;
+        const auto x = c.volume.eval(t);
+        j["degenerate_at"] = {{"uvw", t}, {"xyz", {x[0], x[1], x[2]}}};
+        j["zero_tolerance"] = r.zero_tolerance;
+        degenerate = "det J = 0 (within " + fmt(r.zero_tolerance, 3) + ") on the boundary, e.g. at (u,v,w) = (" +
+                     fmt(t[0], 8) + ", " + fmt(t[1], 8) + ", " + fmt(t[2], 8) + "), xyz (" + fmt(x[0], 8) + ", " +
+                     fmt(x[1], 8) + ", " + fmt(x[2], 8) + "); det J > 0 inside";
+      }
       if (r.invalid_at) {
         const auto& t = *r.invalid_at;
         const auto x = c.volume.eval(t);
@@ -59,6 +70,7 @@ void add_validate(CLI::App& app, Common& common) {
                     r.orientation > 0 ? "right" : r.orientation < 0 ? "left" : "singular", fmt(r.min_bound, 8).c_str(),
                     fmt(r.max_bound, 8).c_str());
         if (!where.empty()) std::printf("  first invalid point: %s\n", where.c_str());
+        if (r.verdict == geom::Validity::degenerate) std::printf("  %s\n", degenerate.c_str());
         if (r.verdict == geom::Validity::undecided)
           std::printf("  det J comes within [%s, %s] of 0 without being seen to reach it\n", fmt(r.min_bound, 6).c_str(),
                       fmt(r.max_bound, 6).c_str());

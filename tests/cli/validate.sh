@@ -64,4 +64,48 @@ assert det * orient <= 1e-9, (det, c)
 assert abs(det - c["invalid_at"]["det"]) < 1e-9 * max(1, abs(det)), (det, c)
 PY
 expect_fail "no such file" "$trivox" validate "$tmp/none.json"
+
+# Degenerate boundaries: the box and cylinder's ruled fillet cells have det J = 0 along their
+# rails by construction (seed 000 Sec. 9) and > 0 inside: `degenerate`, not invalid. The
+# reported point lies on the domain's boundary and det J there, evaluated independently by
+# central differences of `trivox eval`, is 0 to the scale of the cell.
+"$trivox" build models/box_cylinder.json -o "$tmp/bc.json" > /dev/null
+"$trivox" validate "$tmp/bc.json" --json > "$tmp/bc.out" || true
+"$py" - "$tmp/bc.out" "$trivox" "$tmp/bc.json" <<'PY'
+import sys, json, subprocess
+r = json.load(open(sys.argv[1]))
+model = json.load(open(sys.argv[3]))
+dom = {c["name"]: [(k[0], k[-1]) for k in c["trivariate"]["knots"]] for c in model["cells"]}
+cells = {c["name"]: c for c in r["cells"]}
+pieces = [n for n in cells if n.startswith("ring.") and not n.startswith("ring.c")]
+assert len(pieces) == 16 or len(pieces) == 20, sorted(cells)
+for n in pieces:
+    c = cells[n]
+    assert c["verdict"] == "degenerate" and c["valid"] is True, c
+    t = c["degenerate_at"]["uvw"]
+    assert any(x in dom[n][d] for d, x in enumerate(t)), (c, dom[n])
+    assert 0 < c["zero_tolerance"] < 1e-8 * c["max_jacobian"], c
+for n, c in cells.items():
+    if not n.startswith("ring."):
+        assert c["verdict"] == "valid", c
+# det J at a degenerate point and just inside it, by differences of the evaluated map.
+import numpy as np
+c = cells[pieces[0]]
+def X(t):
+    out = subprocess.run([sys.argv[2], "eval", sys.argv[3], "--cell", pieces[0], "--uvw", ",".join(repr(v) for v in t), "--json"],
+                         capture_output=True, text=True, check=True).stdout
+    return np.array(json.loads(out)["point"])
+def det(t, h=1e-6):
+    cols = []
+    for d in range(3):
+        a, b = list(t), list(t)
+        lo, hi = dom[pieces[0]][d]
+        a[d] = min(hi, t[d] + h); b[d] = max(lo, t[d] - h)
+        cols.append((X(a) - X(b)) / (a[d] - b[d]))
+    return np.linalg.det(np.array(cols).T)
+t = c["degenerate_at"]["uvw"]
+assert abs(det(t)) < 1e-5 * c["max_jacobian"], (det(t), c)
+inside = [0.5 * (x + 0.5 * (lo + hi)) for x, (lo, hi) in zip(t, dom[pieces[0]])]
+assert det(inside) > 1e-3 * c["max_jacobian"], (det(inside), c)
+PY
 echo "validate: ok"

@@ -109,14 +109,52 @@ TEST_CASE("a folded cell is invalid, at a point where det J really has the wrong
   CHECK(*again.invalid_at == *r.invalid_at);
 }
 
-TEST_CASE("a collapsed face makes det J zero there: invalid", "[validity]") {
-  // x = u, y = u v, z = w: the face u = 0 collapses to a segment, det J = u.
+TEST_CASE("a collapsed face or edge is a degenerate boundary; a zero inside is invalid", "[validity]") {
+  // x = u, y = u v, z = w: the face u = 0 collapses to a segment, det J = u: > 0 inside, 0 on
+  // that face only.
   const auto s = tricubic([](double u, double v, double w) { return std::array<double, 3>{u, u * v, w}; });
   const auto r = geom::check_validity(s);
-  REQUIRE(r.verdict == geom::Validity::invalid);
-  CHECK((*r.invalid_at)[0] == 0.0);
-  CHECK(r.det_at_invalid == Approx(0).margin(1e-14));
+  REQUIRE(r.verdict == geom::Validity::degenerate);
+  CHECK(std::string(geom::validity_name(r.verdict)) == "degenerate");
+  CHECK(r.orientation == 1);
+  REQUIRE(r.degenerate_at);
+  CHECK((*r.degenerate_at)[0] == 0.0);
+  CHECK(det_at(s, *r.degenerate_at) == Approx(0).margin(1e-14));
+  CHECK_FALSE(r.invalid_at);
   CHECK(r.min_bound == Approx(0).margin(1e-12));
+  CHECK(r.zero_tolerance > 0);
+  CHECK(r.zero_tolerance < 1e-9);
+  check_bounds_enclose(s, r);
+  // x = u, y = u v, z = u w: the face u = 0 collapses to a point, det J = u^2.
+  const auto apex = tricubic([](double u, double v, double w) { return std::array<double, 3>{u, u * v, u * w}; });
+  const auto a = geom::check_validity(apex);
+  CHECK(a.verdict == geom::Validity::degenerate);
+  REQUIRE(a.degenerate_at);
+  CHECK((*a.degenerate_at)[0] == 0.0);
+  // Left-handed with a collapsed face: degenerate too, with orientation -1.
+  const auto left = tricubic([](double u, double v, double w) { return std::array<double, 3>{u * v, u, w}; });
+  const auto l = geom::check_validity(left);
+  CHECK(l.verdict == geom::Validity::degenerate);
+  CHECK(l.orientation == -1);
+  // x = (u - 1/2)^3 (Bezier coefficients -1/8, 1/8, -1/8, 1/8 along u), y = v, z = w:
+  // det J = 3 (u - 1/2)^2 >= 0, but 0 on the plane u = 1/2 inside the domain: invalid there (the
+  // map is not locally invertible).
+  const auto inner = tricubic([](double u, double v, double w) {
+    static constexpr double c[4] = {-0.125, 0.125, -0.125, 0.125};
+    return std::array<double, 3>{c[std::lround(3 * u)], v, w};
+  });
+  CHECK(det_at(inner, {0.5, 0.3, 0.7}) == Approx(0).margin(1e-15));
+  CHECK(det_at(inner, {0.2, 0.3, 0.7}) == Approx(3 * 0.09).epsilon(1e-12));
+  const auto i = geom::check_validity(inner);
+  REQUIRE(i.verdict == geom::Validity::invalid);
+  REQUIRE(i.invalid_at);
+  CHECK((*i.invalid_at)[0] == Approx(0.5).margin(1e-12));
+  CHECK(i.det_at_invalid == Approx(0).margin(1e-12));
+  // x with control points u^2 - u/2 at u = i/3, i.e. x = u^2 - u/2 + u (1 - u) / 3: dx/du =
+  // 4u/3 - 1/6 < 0 for u < 1/8, > 0 beyond: det J takes both signs, invalid (not degenerate)
+  // though it is small near the face u = 0.
+  const auto folded = tricubic([](double u, double v, double w) { return std::array<double, 3>{u * u - 0.5 * u, v, w}; });
+  CHECK(geom::check_validity(folded).verdict == geom::Validity::invalid);
 }
 
 TEST_CASE("planar surfaces: a convex quad is valid, a bow tie is not", "[validity]") {

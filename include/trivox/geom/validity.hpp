@@ -27,10 +27,14 @@ namespace trivox::geom {
 enum class Validity {
   valid,      ///< det J has one strict sign everywhere
   invalid,    ///< det J is zero somewhere, or takes both signs (see ValidityReport::invalid_at)
-  undecided   ///< subdivision reached min_width with det J within the bounds of 0
+  undecided,  ///< subdivision reached min_width with det J within the bounds of 0
+  /// det J has one strict sign in the open domain and is 0 (within zero_tolerance) on part of its
+  /// boundary (ValidityReport::degenerate_at): a valid parametrisation of the open cell whose
+  /// boundary collapses there (see the file comment)
+  degenerate
 };
 
-/// "valid", "invalid" or "undecided".
+/// "valid", "invalid", "undecided" or "degenerate".
 const char* validity_name(Validity v) noexcept;
 
 template <int P>
@@ -47,6 +51,12 @@ struct ValidityReport {
   /// orientation; det_at_invalid is its value there.
   std::optional<std::array<double, P>> invalid_at;
   double det_at_invalid = 0.0;
+  /// For a degenerate cell: a boundary point where det J is 0 within zero_tolerance (the centre of
+  /// the first such face, edge or corner of a Bezier piece found, in the fixed order).
+  std::optional<std::array<double, P>> degenerate_at;
+  /// |det J| at or below this counts as 0 on the boundary, and coefficients down to -this as
+  /// non-negative: 1e-10 times the largest |coefficient| of det J's spline.
+  double zero_tolerance = 0.0;
   int pieces = 0;           ///< Bezier pieces examined
 };
 
