@@ -155,8 +155,8 @@ ValidityReport<P> check(const Piece<P>& x, const ValidityOptions& opt, int coord
     const auto [lo_it, hi_it] = std::minmax_element(c.begin(), c.end());
     const double lo = *lo_it, hi = *hi_it;
     for (int k = 0; k < (1 << P); ++k) seen(c[static_cast<std::size_t>(s.row(corner_index(s, k)))], corner_params(s, k));
-    if (r.invalid_at) {
-      // Proven invalid: the bounds of what is left still count.
+    // Proven invalid: the bounds of this piece and of what is left still count.
+    auto bound_rest = [&] {
       r.min_bound = std::min(r.min_bound, lo);
       r.max_bound = std::max(r.max_bound, hi);
       for (const auto& rest : stack) {
@@ -164,6 +164,9 @@ ValidityReport<P> check(const Piece<P>& x, const ValidityOptions& opt, int coord
         r.min_bound = std::min(r.min_bound, *std::min_element(q.begin(), q.end()));
         r.max_bound = std::max(r.max_bound, *std::max_element(q.begin(), q.end()));
       }
+    };
+    if (r.invalid_at) {
+      bound_rest();
       break;
     }
     const bool decided = r.orientation > 0 ? lo > 0.0 : hi < 0.0;
@@ -183,14 +186,7 @@ ValidityReport<P> check(const Piece<P>& x, const ValidityOptions& opt, int coord
       // A face, edge or corner inside the domain where det J is 0 (within rounding).
       r.invalid_at = *zero_at;
       r.det_at_invalid = s.eval(*zero_at)[0];
-      stack.push_back(std::move(s));  // its bounds count with the rest
-      r.min_bound = std::min(r.min_bound, lo);
-      r.max_bound = std::max(r.max_bound, hi);
-      for (const auto& rest : stack) {
-        const auto q = rest.points();
-        r.min_bound = std::min(r.min_bound, *std::min_element(q.begin(), q.end()));
-        r.max_bound = std::max(r.max_bound, *std::max_element(q.begin(), q.end()));
-      }
+      bound_rest();
       break;
     }
     // Undecided: look at its centre, then split its widest direction (relative to the domain).

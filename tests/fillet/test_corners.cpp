@@ -26,19 +26,7 @@ namespace {
 /// the Z axis, the edge): by Green's theorem oint X^2 / 2 dZ, only the section contributes;
 /// exact with 8 Gauss points (degree 8 integrand).
 double hermite_moment(double d1, double d2, double tau) {
-  const double w = tau * std::hypot(d1, d2);
-  const double P[4][2] = {{d1, 0}, {d1 - w / 3, 0}, {0, d2 - w / 3}, {0, d2}};
-  const trivox::geom::GaussRule g = trivox::geom::gauss_legendre(8);
-  double m = 0.0;
-  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
-    const double t = 0.5 * (g.nodes[i] + 1), s = 1 - t;
-    const double B[4] = {s * s * s, 3 * t * s * s, 3 * t * t * s, t * t * t};
-    const double dB[4] = {-3 * s * s, 3 * s * s - 6 * t * s, 6 * t * s - 3 * t * t, 3 * t * t};
-    double X = 0, dZ = 0;
-    for (int j = 0; j < 4; ++j) X += B[j] * P[j][0], dZ += dB[j] * P[j][1];
-    m += 0.5 * g.weights[i] * 0.5 * X * X * dZ;
-  }
-  return m;
+  return fillet_test::hermite_integral(d1, d2, tau, [](double X, double, double, double dZ) { return 0.5 * X * X * dZ; });
 }
 
 double dist(const std::array<double, 3>& a, const std::vector<double>& b) {
