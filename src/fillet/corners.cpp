@@ -173,6 +173,20 @@ std::array<double, 2> det_range(const Trivariate& h) {
   return r;
 }
 
+/// The bridge's cells: sampled det J and volumes.
+void measure_cells(CornerFillet& cf) {
+  CornerQuality& qa = cf.quality;
+  qa.det_min = std::numeric_limits<double>::infinity();
+  qa.det_max = -qa.det_min;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const auto rg = det_range(cf.cells[c]);
+    qa.cell_jacobian[c] = rg;
+    qa.det_min = std::min(qa.det_min, rg[0]);
+    qa.det_max = std::max(qa.det_max, rg[1]);
+    qa.cell_volume[c] = std::abs(boundary_volume(cf.cells[c]));
+  }
+}
+
 }  // namespace
 
 CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, double tol, const SubregionOptions& sopt) {
@@ -296,34 +310,86 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
       qa.g1_angle = std::max(qa.g1_angle, std::acos(std::min(1.0, cs)));
     }
   }
-  qa.det_min = std::numeric_limits<double>::infinity();
-  qa.det_max = -qa.det_min;
-  for (std::size_t c = 0; c < 2; ++c) {
-    const auto rg = det_range(out.cells[c]);
-    qa.cell_jacobian[c] = rg;
-    qa.det_min = std::min(qa.det_min, rg[0]);
-    qa.det_max = std::max(qa.det_max, rg[1]);
-    qa.cell_volume[c] = std::abs(boundary_volume(out.cells[c]));
-  }
+  measure_cells(out);
   qa.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 
 namespace {
 
-/// Largest xyz distance between two faces at the same relative parameters (13 x 13 samples).
-double face_gap(const Surface& a, const Surface& b) {
-  double worst = 0.0;
+/// Largest xyz distance, and largest property difference (coordinates 3..k-1), between two faces
+/// at the same relative parameters (13 x 13 samples).
+std::array<double, 2> face_gaps(const Surface& a, const Surface& b) {
+  std::array<double, 2> worst{};
   constexpr int n = 12;
   const auto au = a.domain(0), av = a.domain(1), bu = b.domain(0), bv = b.domain(1);
   for (int i = 0; i <= n; ++i)
     for (int j = 0; j <= n; ++j) {
       const double s = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
-      const Vec x = xyz(a.eval({au[0] + (au[1] - au[0]) * s, av[0] + (av[1] - av[0]) * t}));
-      const Vec y = xyz(b.eval({bu[0] + (bu[1] - bu[0]) * s, bv[0] + (bv[1] - bv[0]) * t}));
-      worst = std::max(worst, norm(sub(x, y)));
+      const auto x = a.eval({au[0] + (au[1] - au[0]) * s, av[0] + (av[1] - av[0]) * t});
+      const auto y = b.eval({bu[0] + (bu[1] - bu[0]) * s, bv[0] + (bv[1] - bv[0]) * t});
+      worst[0] = std::max(worst[0], norm(sub(xyz(x), xyz(y))));
+      for (std::size_t c = 3; c < x.size() && c < y.size(); ++c) worst[1] = std::max(worst[1], std::abs(x[c] - y[c]));
     }
   return worst;
+}
+
+/// The bridge's singular rows (corners.hpp), control point (v index a, w index b) of half
+/// `half` (nv points along v): in the fan half (on S_g, half gs) the collapsed C edge (v at C,
+/// w = 0), all o; in the segment half the face w = 0 (the edge segment o r, the same in every
+/// layer along phi) and the rail face (v at the rail), all r.
+bool singular_row(std::size_t half, std::size_t gs, int a, int b, int nv) {
+  const int c_side = half == 0 ? nv - 1 : 0, rail_side = nv - 1 - c_side;
+  if (half == gs) return a == c_side && b == 0;
+  return b == 0 || a == rail_side;
+}
+
+/// Makes the singular rows exactly the same in every layer along phi (the middle layer's): the
+/// fan's and the segment's fits hold them constant only to rounding.
+void exact_singular_rows(std::array<Trivariate, 2>& cells, std::size_t gs) {
+  for (std::size_t c = 0; c < 2; ++c) {
+    Trivariate& h = cells[c];
+    const int nu = h.count(0), nv = h.count(1), nw = h.count(2), mid = nu / 2;
+    const std::size_t k = static_cast<std::size_t>(h.dim());
+    for (int b = 0; b < nw; ++b)
+      for (int a = 0; a < nv; ++a)
+        if (singular_row(c, gs, a, b, nv))
+          for (int i = 0; i < nu; ++i)
+            if (i != mid) std::copy_n(h.point(h.row({mid, a, b})).data(), k, h.point(h.row({i, a, b})).data());
+  }
+}
+
+/// Pins the bridge's end face `end` (u0 or u1) onto the neighbour's end face `nb_end`, half for
+/// half: each pair of cells is brought into one (v, w) function space (exact: knot insertion and
+/// degree raising), the neighbour's end layer takes the bridge's singular rows (it moves there by
+/// its fit's error: its C end, its edge segment and r), and the bridge's end layer becomes the
+/// neighbour's. The faces are then one function, so the C0 glue of Sec. 6.1 holds to rounding,
+/// whatever the neighbour's fit and the bridge's interpolated section differed by, and the
+/// bridge keeps its exact singular structure (det J = 0 on the collapsed edges, not slightly
+/// negative). The change fades out over the first knot span along phi.
+void pin_end(std::array<Trivariate, 2>& cells, std::size_t gs, spline::Face end, std::vector<Trivariate>& nb,
+             spline::Face nb_end) {
+  for (std::size_t c = 0; c < 2; ++c) {
+    Trivariate& cell = cells[c];
+    Trivariate& n = nb.at(c);
+    if (cell.rational() || n.rational() || !cell.knots(0).clamped() || !n.knots(0).clamped() || cell.count(0) < 2)
+      throw Error("fillet corner: cannot pin a rational or unclamped cell", ErrorKind::failed);
+    for (int d = 1; d < 3; ++d) n = spline::reparametrize(n, d, cell.domain(d)[0], cell.domain(d)[1]);
+    const auto [ca, cb] = spline::make_compatible(spline::boundary_face(cell, end), spline::boundary_face(n, nb_end));
+    for (int d = 0; d < 2; ++d) {
+      cell = spline::to_space(cell, d + 1, ca.knots(d));
+      n = spline::to_space(n, d + 1, ca.knots(d));
+    }
+    const int i = end == spline::Face::u0 ? 0 : cell.count(0) - 1, inner = i == 0 ? 1 : i - 1;
+    const int in = nb_end == spline::Face::u0 ? 0 : n.count(0) - 1;
+    const std::size_t k = static_cast<std::size_t>(cell.dim());
+    for (int b = 0; b < cell.count(2); ++b)
+      for (int a = 0; a < cell.count(1); ++a) {
+        double* src = n.point(n.row({in, a, b})).data();
+        if (singular_row(c, gs, a, b, cell.count(1))) std::copy_n(cell.point(cell.row({inner, a, b})).data(), k, src);
+        std::copy_n(src, k, cell.point(cell.row({i, a, b})).data());
+      }
+  }
 }
 
 Vec eval3(const Surface& s, const Curve& c, double t, Vec* tangent = nullptr) {
@@ -570,18 +636,60 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
                      piece_name(pb, side1, side2));
     }
     cf.junction = jidx;
-    // C0 glue: the bridge's end faces against the neighbours' end faces at the same (v, w),
-    // cell for cell (both are ruled halves: v from the rail to C, w from S^_i to S_b); the
-    // pair of ends (u0 or u1 of each) that fits best is the junction.
+    // C0 glue (Sec. 6.1: the bridge meets its neighbours along their end sections): the
+    // bridge's end faces against the neighbours' end faces at the same (v, w), cell for cell
+    // (both are ruled halves: v from the rail to C, w from S^_i to S_b); the pair of ends (u0 or
+    // u1 of each) that fits best is the junction. Measured, then pinned (pin_end) and measured
+    // again: glue_before is what the bridge's own fit and section left, glue what remains.
+    std::array<spline::Face, 2> taken{spline::Face::v0, spline::Face::v0};
     for (std::size_t side = 0; side < 2; ++side) {
-      const FilletPiece& nb = side == 0 ? pa : pb;
+      FilletPiece& nb = out.pieces[jn.piece[side]];
       double best = std::numeric_limits<double>::infinity();
-      for (const Fillet& fl : nb.fillets)
+      Fillet* best_f = nullptr;
+      spline::Face best_n = spline::Face::u0, best_b = spline::Face::u0;
+      std::array<double, 2> best_jump{};
+      for (Fillet& fl : nb.fillets)
         for (spline::Face fn : {spline::Face::u0, spline::Face::u1})
-          for (spline::Face fb : {spline::Face::u0, spline::Face::u1})
-            best = std::min(best, std::max(face_gap(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn)),
-                                           face_gap(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn))));
-      cf.quality.glue[side] = best;
+          for (spline::Face fb : {spline::Face::u0, spline::Face::u1}) {
+            if (fb == taken[0]) continue;  // the other end of the bridge is the other neighbour's
+            const auto g0 = face_gaps(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn));
+            const auto g1 = face_gaps(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn));
+            const double g = std::max(g0[0], g1[0]);
+            if (g < best) best = g, best_f = &fl, best_n = fn, best_b = fb, best_jump = {g0[1], g1[1]};
+          }
+      cf.quality.glue_before[side] = best;
+      cf.quality.property_jump_before[side] = std::max(best_jump[0], best_jump[1]);
+      if (best_f == nullptr || !(best <= jt))
+        throw Error("fillet corner at " + at(jn.o) + ": the bridge's end section lies " + num(best) +
+                        " from the neighbour " + piece_name(nb, side1, side2) + "'s; expected at most the join tolerance " +
+                        num(jt),
+                    ErrorKind::failed);
+      taken[side] = best_b;
+      cf.ends[side] = best_b;
+      if (side == 0) exact_singular_rows(cf.cells, gs);
+      pin_end(cf.cells, gs, best_b, best_f->cells, best_n);
+      std::array<double, 2> after{};
+      for (std::size_t c = 0; c < 2; ++c) {
+        const auto g = face_gaps(spline::boundary_face(cf.cells[c], best_b), spline::boundary_face(best_f->cells.at(c), best_n));
+        after = {std::max(after[0], g[0]), std::max(after[1], g[1])};
+      }
+      cf.quality.glue[side] = after[0];
+      cf.quality.property_jump[side] = after[1];
+    }
+    measure_cells(cf);
+    // The rail's ends after pinning: the neighbours' rail ends, p and q.
+    {
+      // The half on S_g: its face v = 0 (half 0) or v = 1 (half 1) collapses onto the rail.
+      const Trivariate& h = cf.cells[gs];
+      const auto du = h.domain(0), dv = h.domain(1), dw = h.domain(2);
+      const double v = dv[gs];
+      double e = 0.0;
+      for (std::size_t side = 0; side < 2; ++side) {
+        const double u = du[cf.ends[side] == spline::Face::u0 ? 0 : 1];
+        const Vec want = side == 0 ? jn.p : jn.q;
+        e = std::max(e, norm(sub(xyz(h.eval({u, v, dw[0]})), want)));
+      }
+      cf.quality.end_error = std::max(cf.quality.end_error, e);
     }
     out.corners.push_back(std::move(cf));
   }

@@ -12,7 +12,8 @@
 #   cylinder cells' sides against three box faces) and four convex corners at (0, +-8, 0) and
 #   (0, +-8, -10), where the box's edges (along y, perpendicular to the cylinder there) cross
 #   the cylinder; p and q are 2 from o on the cylinder, r = o +- (0, 2, 0) on the edge; det J > 0
-#   inside; the bridges glue to their neighbours within the fit tolerance;
+#   inside; the bridges are pinned to their neighbours' end sections: glue at rounding level,
+#   no property jump, and `trivox validate` finds no cell invalid;
 # - bad input exits 2 naming the place: a concave corner (the plate's rails flipped into the
 #   footprint cross), faces that do not meet, "corners" without face lists, the flend section or
 #   the VBS construction with corners, a bad face name in a list.
@@ -54,7 +55,8 @@ for c in k:
     assert abs(c["angle"] - math.pi / 2) < 1e-9, c["angle"]
     assert c["gap_face"] == "plate/w1" and c["edge_face"].startswith("column/"), c
     assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
-    assert max(c["glue"]) < 1e-5 and c["g1_angle"] < 1e-5, (c["glue"], c["g1_angle"])
+    assert max(c["glue"]) < 1e-12 and max(c["glue_before"]) < 1e-5 and c["g1_angle"] < 1e-5, (c["glue"], c["g1_angle"])
+    assert max(c["property_jump"]) < 1e-12, c["property_jump"]
 vol = {x["name"]: x["volume"] for x in r["cells"]}
 pieces = sum(v for n, v in vol.items() if n.startswith("ring.") and not n.startswith("ring.c"))
 bridges = sum(v for n, v in vol.items() if n.startswith("ring.c"))
@@ -98,10 +100,27 @@ for c in k:
     assert abs(c["angle"] - math.pi / 2) < 1e-2, c["angle"]
     assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
     assert max(c["end_error"], c["o_error"], c["r_error"], c["radius_error"]) < 1e-4, c
-    assert max(c["glue"]) < 1e-4 and c["g1_angle"] < 1e-3, (c["glue"], c["g1_angle"])
-    print(f"corner {o[0]:+.4f} {o[1]:+.4f} {o[2]:+.4f}: glue {max(c['glue']):.2e}, G1 {c['g1_angle']:.2e}, "
+    # Pinned to the neighbours' end sections (Sec. 6.1's C0 glue): rounding level, far below the
+    # fillet tolerance 1e-7 * diagonal (5.9e-6); before pinning, the two fits' difference.
+    tol = 5.9e-6  # 1e-7 of the listed cells' bounding-box diagonal
+    assert max(c["glue"]) < 1e-3 * tol and c["g1_angle"] < 1e-3, (c["glue"], c["g1_angle"])
+    assert max(c["glue_before"]) < 1e-4 and max(c["property_jump"]) < 1e-12, (c["glue_before"], c["property_jump"])
+    print(f"corner {o[0]:+.4f} {o[1]:+.4f} {o[2]:+.4f}: glue {max(c['glue']):.2e} (before pinning "
+          f"{max(c['glue_before']):.2e}), property jump {max(c['property_jump_before']):.2e} -> "
+          f"{max(c['property_jump']):.2e}, G1 {c['g1_angle']:.2e}, "
           f"det J {c['min_jacobian']:.3e}..{c['max_jacobian']:.3e}, volume {sum(c['cell_volume']):.6f}")
 assert seen == {(8, 0), (-8, 0), (8, -10), (-8, -10)}, seen
+PY
+# Pinning keeps the bridges' singular structure exact: no cell is found invalid (det J < 0 at a
+# point), the segment halves are proven degenerate (det J = 0 on the edge o r, > 0 inside).
+"$trivox" validate "$tmp/bc.model.json" --json > "$tmp/bc.validate.json" || true
+"$py" - "$tmp/bc.validate.json" <<'PY'
+import sys, json
+r = json.load(open(sys.argv[1]))
+for c in r["cells"]:
+    assert c["verdict"] != "invalid", c
+    if c["name"].startswith("ring.c") and c["name"].endswith("b"):
+        assert c["verdict"] == "degenerate", c
 PY
 # Next to the corner (0, 8, 0), outside the box (x > 0, z > 0) and the cylinder: in a bridge.
 cell=$(loc "$tmp/bc.model.json" 0.3,8.3,0.3)

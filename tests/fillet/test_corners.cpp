@@ -101,8 +101,15 @@ TEST_CASE("fillet across a column's faces: Sec. 6 pieces and Sec. 6.1 bridges at
     CHECK(q.r_error < 1e-9);    // the section ends at r
     CHECK(q.radius_error < tol);
     CHECK(q.g1_angle < 1e-5);
-    CHECK(q.glue[0] < 10 * tol);  // C0 with both neighbours
-    CHECK(q.glue[1] < 10 * tol);
+    // C0 with both neighbours: pinned to their end sections, so one function (rounding level);
+    // before pinning the bridge's own section ended within the fit tolerance of theirs.
+    CHECK(q.glue[0] < 1e-12);
+    CHECK(q.glue[1] < 1e-12);
+    CHECK(q.glue_before[0] < 10 * tol);
+    CHECK(q.glue_before[1] < 10 * tol);
+    CHECK(q.property_jump[0] < 1e-12);  // g_1 = 1 and g_2 = 2 on both sides of the glue
+    CHECK(q.property_jump[1] < 1e-12);
+    CHECK(cf.ends[0] != cf.ends[1]);
     const double v = q.cell_volume[0] + q.cell_volume[1];
     CHECK(v == Approx(bridge_volume).epsilon(1e-5));
     total += v;

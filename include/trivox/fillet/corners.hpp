@@ -54,6 +54,16 @@
 ///   ruled halves (Alg. 2, fillet/ruled_fillet.hpp, properties by Sec. 7.1) glue C0 to them.
 ///   The control points of the section other than the rails are interpolated in phi at the
 ///   Greville points of the fan's knots, halved until within tolerance.
+/// - Exact glue. Built alone, the bridge's end sections equal the neighbours' only to the fits'
+///   tolerance (its fan and their sub-regions are fitted on different knots, its section is
+///   interpolated where theirs comes from blending_surface: up to twice the tolerance apart on
+///   the box and cylinder). fillet_across therefore pins them: per half, the bridge's and the
+///   neighbour's cells are brought into one (v, w) space (exact), the neighbour's end layer takes
+///   the bridge's singular rows (o, the segment o r and r, which the bridge holds the same in
+///   every layer; the neighbour moves there by its own fit error), and the bridge's end layer of
+///   control points becomes the neighbour's. The end faces are then one function, xyz and
+///   properties: glue and property jump at rounding level (CornerQuality::glue, property_jump;
+///   glue_before, property_jump_before: what pinning removed).
 /// det J vanishes on the fan's edge at o and on the segment face (singular by construction, as
 /// on the rails of every ruled fillet) and is checked at interior samples.
 ///
@@ -127,9 +137,16 @@ struct CornerQuality {
   std::array<std::array<double, 2>, 2> cell_jacobian{};  ///< per cell: sampled det J min, max
   std::array<double, 2> cell_volume{};  ///< |int det J| per cell (divergence theorem)
   /// C0 glue: max xyz distance between the bridge's end faces (phi = 0, phi = 1) and the
-  /// neighbouring pieces' end faces at the same (v, w), cell for cell (fillet_across; 0 from
-  /// bridge_corner alone)
+  /// neighbouring pieces' end faces at the same (v, w), cell for cell, after fillet_across pinned
+  /// them (rounding level; 0 from bridge_corner alone)
   std::array<double, 2> glue{};
+  /// The same before pinning: how far the bridge's own fan fit and interpolated section ended
+  /// from the neighbours' (their fits and blending surfaces); what the pinning moved the end
+  /// layers by, in function values
+  std::array<double, 2> glue_before{};
+  /// Property jump across the glued ends: max |g_bridge - g_neighbour| (coordinates 3..k-1) on
+  /// the end faces at the same (v, w), after and before pinning (0 without properties)
+  std::array<double, 2> property_jump{}, property_jump_before{};
   std::array<int, 2> bd_samples{};  ///< samples of B_d; Greville rows of the section
   double seconds = 0.0;
   /// "positive", "negative" or "changes sign".
@@ -141,6 +158,9 @@ struct CornerQuality {
 struct CornerFillet {
   std::size_t junction = 0;  ///< into MultiFillet::junctions
   std::array<spline::Trivariate, 2> cells;
+  /// fillet_across: the cells' faces (u0 or u1) glued to the arriving piece (ends[0]) and to the
+  /// leaving one (ends[1])
+  std::array<spline::Face, 2> ends{spline::Face::u0, spline::Face::u1};
   CornerQuality quality;
 };
 
