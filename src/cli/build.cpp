@@ -239,6 +239,22 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                   {"samples", q2.bd_samples},
                   {"seconds", q2.seconds}});
   }
+  // Concave corners (seed 000 Sec. 6): the pieces clipped at the rails' crossing and stitched.
+  nlohmann::ordered_json js = nlohmann::ordered_json::array();
+  for (const auto& st : built.stitches) {
+    const auto& jn = st.junction;
+    js.push_back({{"name", st.name},
+                  {"pieces", st.pieces},
+                  {"crossing_face", st.faces[0]},
+                  {"edge_face", st.faces[1]},
+                  {"o", jn.o},
+                  {"x", jn.x},
+                  {"r", jn.r},
+                  {"angle", jn.angle},
+                  {"crossing", jn.crossing},
+                  {"glue", jn.glue},
+                  {"glue_before", jn.glue_before}});
+  }
   return {{"scene", opt.scene},
           {"model", opt.output},
           {"units", built.model.units},
@@ -250,6 +266,7 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
           {"fillets", jf},
           {"bridges", jb},
           {"corners", jk},
+          {"stitches", js},
           {"surfaces", scene_surfaces(built)},
           {"constructs", constructs(built)}};
 }
@@ -328,6 +345,16 @@ void print_human(const nlohmann::ordered_json& j) {
                   b["orientation"].get<std::string>().c_str(),
                   fmt(std::max(b["g1_angle"][0].get<double>(), b["g1_angle"][1].get<double>()), 3).c_str(),
                   fmt(b["seconds"].get<double>(), 3).c_str());
+    }
+  }
+  if (!j["stitches"].empty()) {
+    std::printf("\n%-14s %-30s %-30s %11s %11s\n", "stitch", "o", "rails cross at", "pinned", "glue");
+    for (const auto& c : j["stitches"]) {
+      const auto pt = [](const nlohmann::ordered_json& p) {
+        return "(" + fmt(p[0].get<double>(), 6) + ", " + fmt(p[1].get<double>(), 6) + ", " + fmt(p[2].get<double>(), 6) + ")";
+      };
+      std::printf("%-14s %-30s %-30s %11s %11s\n", c["name"].get<std::string>().c_str(), pt(c["o"]).c_str(),
+                  pt(c["x"]).c_str(), fmt(c["glue_before"].get<double>(), 3).c_str(), fmt(c["glue"].get<double>(), 3).c_str());
     }
   }
   if (!j["corners"].empty()) {
