@@ -229,12 +229,31 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                   {"r_error", q2.r_error},
                   {"g1_angle", q2.g1_angle},
                   {"glue", q2.glue},
+                  {"glue_before", q2.glue_before},
+                  {"property_jump", q2.property_jump},
+                  {"property_jump_before", q2.property_jump_before},
                   {"jacobian", q2.jacobian()},
                   {"min_jacobian", q2.det_min},
                   {"max_jacobian", q2.det_max},
                   {"cell_volume", q2.cell_volume},
                   {"samples", q2.bd_samples},
                   {"seconds", q2.seconds}});
+  }
+  // Concave corners (seed 000 Sec. 6): the pieces clipped at the rails' crossing and stitched.
+  nlohmann::ordered_json js = nlohmann::ordered_json::array();
+  for (const auto& st : built.stitches) {
+    const auto& jn = st.junction;
+    js.push_back({{"name", st.name},
+                  {"pieces", st.pieces},
+                  {"crossing_face", st.faces[0]},
+                  {"edge_face", st.faces[1]},
+                  {"o", jn.o},
+                  {"x", jn.x},
+                  {"r", jn.r},
+                  {"angle", jn.angle},
+                  {"crossing", jn.crossing},
+                  {"glue", jn.glue},
+                  {"glue_before", jn.glue_before}});
   }
   return {{"scene", opt.scene},
           {"model", opt.output},
@@ -247,6 +266,7 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
           {"fillets", jf},
           {"bridges", jb},
           {"corners", jk},
+          {"stitches", js},
           {"surfaces", scene_surfaces(built)},
           {"constructs", constructs(built)}};
 }
@@ -327,18 +347,29 @@ void print_human(const nlohmann::ordered_json& j) {
                   fmt(b["seconds"].get<double>(), 3).c_str());
     }
   }
+  if (!j["stitches"].empty()) {
+    std::printf("\n%-14s %-30s %-30s %11s %11s\n", "stitch", "o", "rails cross at", "pinned", "glue");
+    for (const auto& c : j["stitches"]) {
+      const auto pt = [](const nlohmann::ordered_json& p) {
+        return "(" + fmt(p[0].get<double>(), 6) + ", " + fmt(p[1].get<double>(), 6) + ", " + fmt(p[2].get<double>(), 6) + ")";
+      };
+      std::printf("%-14s %-30s %-30s %11s %11s\n", c["name"].get<std::string>().c_str(), pt(c["o"]).c_str(),
+                  pt(c["x"]).c_str(), fmt(c["glue_before"].get<double>(), 3).c_str(), fmt(c["glue"].get<double>(), 3).c_str());
+    }
+  }
   if (!j["corners"].empty()) {
-    std::printf("\n%-14s %-30s %11s %11s %11s %-13s %12s %8s\n", "corner", "o", "rail error", "glue", "G1 (rad)",
-                "det J", "volume", "seconds");
+    std::printf("\n%-14s %-30s %11s %11s %11s %11s %-13s %12s %8s\n", "corner", "o", "rail error", "pinned", "glue",
+                "G1 (rad)", "det J", "volume", "seconds");
     for (const auto& c : j["corners"]) {
       const auto& o = c["o"];
       const std::string at = "(" + fmt(o[0].get<double>(), 6) + ", " + fmt(o[1].get<double>(), 6) + ", " +
                              fmt(o[2].get<double>(), 6) + ")";
       const double rail = std::max({c["end_error"].get<double>(), c["radius_error"].get<double>(),
                                     c["o_error"].get<double>(), c["r_error"].get<double>()});
-      std::printf("%-14s %-30s %11s %11s %11s %-13s %12s %8s\n",
+      std::printf("%-14s %-30s %11s %11s %11s %11s %-13s %12s %8s\n",
                   c["cells"][0].get<std::string>().substr(0, c["cells"][0].get<std::string>().size() - 1).c_str(),
                   at.c_str(), fmt(rail, 3).c_str(),
+                  fmt(std::max(c["glue_before"][0].get<double>(), c["glue_before"][1].get<double>()), 3).c_str(),
                   fmt(std::max(c["glue"][0].get<double>(), c["glue"][1].get<double>()), 3).c_str(),
                   fmt(c["g1_angle"].get<double>(), 3).c_str(), c["jacobian"].get<std::string>().c_str(),
                   fmt(c["cell_volume"][0].get<double>() + c["cell_volume"][1].get<double>(), 8).c_str(),

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <string>
 
 #include "fillet_util.hpp"
+#include "trivox/construct/constructors.hpp"
 #include "trivox/error.hpp"
 #include "trivox/fillet/ruled_fillet.hpp"
 #include "trivox/geom/surface_intersection.hpp"
@@ -173,6 +175,20 @@ std::array<double, 2> det_range(const Trivariate& h) {
   return r;
 }
 
+/// The bridge's cells: sampled det J and volumes.
+void measure_cells(CornerFillet& cf) {
+  CornerQuality& qa = cf.quality;
+  qa.det_min = std::numeric_limits<double>::infinity();
+  qa.det_max = -qa.det_min;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const auto rg = det_range(cf.cells[c]);
+    qa.cell_jacobian[c] = rg;
+    qa.det_min = std::min(qa.det_min, rg[0]);
+    qa.det_max = std::max(qa.det_max, rg[1]);
+    qa.cell_volume[c] = std::abs(boundary_volume(cf.cells[c]));
+  }
+}
+
 }  // namespace
 
 CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, double tol, const SubregionOptions& sopt) {
@@ -296,34 +312,219 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
       qa.g1_angle = std::max(qa.g1_angle, std::acos(std::min(1.0, cs)));
     }
   }
-  qa.det_min = std::numeric_limits<double>::infinity();
-  qa.det_max = -qa.det_min;
-  for (std::size_t c = 0; c < 2; ++c) {
-    const auto rg = det_range(out.cells[c]);
-    qa.cell_jacobian[c] = rg;
-    qa.det_min = std::min(qa.det_min, rg[0]);
-    qa.det_max = std::max(qa.det_max, rg[1]);
-    qa.cell_volume[c] = std::abs(boundary_volume(out.cells[c]));
-  }
+  measure_cells(out);
   qa.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 
 namespace {
 
-/// Largest xyz distance between two faces at the same relative parameters (13 x 13 samples).
-double face_gap(const Surface& a, const Surface& b) {
-  double worst = 0.0;
+/// Largest xyz distance, and largest property difference (coordinates 3..k-1), between two faces
+/// at the same relative parameters (13 x 13 samples).
+std::array<double, 2> face_gaps(const Surface& a, const Surface& b) {
+  std::array<double, 2> worst{};
   constexpr int n = 12;
   const auto au = a.domain(0), av = a.domain(1), bu = b.domain(0), bv = b.domain(1);
   for (int i = 0; i <= n; ++i)
     for (int j = 0; j <= n; ++j) {
       const double s = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
-      const Vec x = xyz(a.eval({au[0] + (au[1] - au[0]) * s, av[0] + (av[1] - av[0]) * t}));
-      const Vec y = xyz(b.eval({bu[0] + (bu[1] - bu[0]) * s, bv[0] + (bv[1] - bv[0]) * t}));
-      worst = std::max(worst, norm(sub(x, y)));
+      const auto x = a.eval({au[0] + (au[1] - au[0]) * s, av[0] + (av[1] - av[0]) * t});
+      const auto y = b.eval({bu[0] + (bu[1] - bu[0]) * s, bv[0] + (bv[1] - bv[0]) * t});
+      worst[0] = std::max(worst[0], norm(sub(xyz(x), xyz(y))));
+      for (std::size_t c = 3; c < x.size() && c < y.size(); ++c) worst[1] = std::max(worst[1], std::abs(x[c] - y[c]));
     }
   return worst;
+}
+
+/// The bridge's singular rows (corners.hpp), control point (v index a, w index b) of half
+/// `half` (nv points along v): in the fan half (on S_g, half gs) the collapsed C edge (v at C,
+/// w = 0), all o; in the segment half the face w = 0 (the edge segment o r, the same in every
+/// layer along phi) and the rail face (v at the rail), all r.
+bool singular_row(std::size_t half, std::size_t gs, int a, int b, int nv) {
+  const int c_side = half == 0 ? nv - 1 : 0, rail_side = nv - 1 - c_side;
+  if (half == gs) return a == c_side && b == 0;
+  return b == 0 || a == rail_side;
+}
+
+/// Makes the singular rows exactly the same in every layer along phi (the middle layer's): the
+/// fan's and the segment's fits hold them constant only to rounding.
+void exact_singular_rows(std::array<Trivariate, 2>& cells, std::size_t gs) {
+  for (std::size_t c = 0; c < 2; ++c) {
+    Trivariate& h = cells[c];
+    const int nu = h.count(0), nv = h.count(1), nw = h.count(2), mid = nu / 2;
+    const std::size_t k = static_cast<std::size_t>(h.dim());
+    for (int b = 0; b < nw; ++b)
+      for (int a = 0; a < nv; ++a)
+        if (singular_row(c, gs, a, b, nv))
+          for (int i = 0; i < nu; ++i)
+            if (i != mid) std::copy_n(h.point(h.row({mid, a, b})).data(), k, h.point(h.row({i, a, b})).data());
+  }
+}
+
+/// Pins the bridge's end face `end` (u0 or u1) onto the neighbour's end face `nb_end`, half for
+/// half: each pair of cells is brought into one (v, w) function space (exact: knot insertion and
+/// degree raising), the neighbour's end layer takes the bridge's singular rows (it moves there by
+/// its fit's error: its C end, its edge segment and r), and the bridge's end layer becomes the
+/// neighbour's. The faces are then one function, so the C0 glue of Sec. 6.1 holds to rounding,
+/// whatever the neighbour's fit and the bridge's interpolated section differed by, and the
+/// bridge keeps its exact singular structure (det J = 0 on the collapsed edges, not slightly
+/// negative). The change fades out over the first knot span along phi.
+/// With gs < 0 (a stitch: no singular rows) the neighbour is left as it is.
+void pin_end(std::span<Trivariate> cells, int gs, spline::Face end, std::span<Trivariate> nb, spline::Face nb_end) {
+  if (cells.size() != 2 || nb.size() != 2) throw Error("fillet corner: expected two ruled halves", ErrorKind::failed);
+  for (std::size_t c = 0; c < 2; ++c) {
+    Trivariate& cell = cells[c];
+    Trivariate& n = nb[c];
+    if (cell.rational() || n.rational() || !cell.knots(0).clamped() || !n.knots(0).clamped() || cell.count(0) < 2)
+      throw Error("fillet corner: cannot pin a rational or unclamped cell", ErrorKind::failed);
+    for (int d = 1; d < 3; ++d) n = spline::reparametrize(n, d, cell.domain(d)[0], cell.domain(d)[1]);
+    const auto [ca, cb] = spline::make_compatible(spline::boundary_face(cell, end), spline::boundary_face(n, nb_end));
+    for (int d = 0; d < 2; ++d) {
+      cell = spline::to_space(cell, d + 1, ca.knots(d));
+      n = spline::to_space(n, d + 1, ca.knots(d));
+    }
+    const int i = end == spline::Face::u0 ? 0 : cell.count(0) - 1, inner = i == 0 ? 1 : i - 1;
+    const int in = nb_end == spline::Face::u0 ? 0 : n.count(0) - 1;
+    const std::size_t k = static_cast<std::size_t>(cell.dim());
+    for (int b = 0; b < cell.count(2); ++b)
+      for (int a = 0; a < cell.count(1); ++a) {
+        double* src = n.point(n.row({in, a, b})).data();
+        if (gs >= 0 && singular_row(c, static_cast<std::size_t>(gs), a, b, cell.count(1))) std::copy_n(cell.point(cell.row({inner, a, b})).data(), k, src);
+        std::copy_n(src, k, cell.point(cell.row({i, a, b})).data());
+      }
+  }
+}
+
+/// Where two rails on one face cross: s on ra, t on rb (both in the face's parameters), by
+/// Newton on ra(s) = rb(t) from (s0, t0), the rails' ends at the corner. False when it does not
+/// converge inside both domains.
+bool rails_cross(const Curve& ra, const Curve& rb, double& s, double& t) {
+  for (int it = 0; it < 60; ++it) {
+    const auto a = ra.eval_derivatives({s}, 1), b = rb.eval_derivatives({t}, 1);
+    const double fx = a[0] - b[0], fy = a[1] - b[1];
+    if (std::hypot(fx, fy) <= 1e-15 * (1.0 + std::hypot(a[0], a[1]))) return true;
+    // [a' -b'] (ds, dt) = -f
+    const double det = a[2] * (-b[3]) - (-b[2]) * a[3];
+    if (!(std::abs(det) > 0.0)) return false;
+    const double ds = (-fx * (-b[3]) + b[2] * (-fy)) / det;
+    const double dt = (a[2] * (-fy) - a[3] * (-fx)) / det;
+    s = std::clamp(s + ds, 0.0, 1.0);
+    t = std::clamp(t + dt, 0.0, 1.0);
+  }
+  return false;
+}
+
+/// The root in u of (f(u, v) - o) . n on [lo, hi] (sign change from the clipped end `near`
+/// towards `far`), or `near` when f(near, v) is already on the kept side (`side` > 0: kept
+/// where (f - o) . n has the sign of side). Bisection, then secant polish.
+double plane_root(const Surface& f, double v, const Vec& o, const Vec& n, double side, double near, double far) {
+  const auto g = [&](double u) { return side * dot(sub(xyz(f.eval({u, v})), o), n); };
+  double a = near, b = far, ga = g(a), gb = g(b);
+  if (ga >= 0.0) return near;
+  if (gb <= 0.0) return far;
+  for (int it = 0; it < 200 && std::abs(b - a) > 1e-15 * (1.0 + std::abs(a)); ++it) {
+    double m = a - ga * (b - a) / (gb - ga);  // regula falsi (Illinois)
+    if (!(m > std::min(a, b) && m < std::max(a, b))) m = 0.5 * (a + b);
+    const double gm = g(m);
+    if (gm == 0.0) return m;
+    if ((gm < 0.0) == (ga < 0.0)) a = m, ga = gm, gb *= 0.5;
+    else b = m, gb = gm, ga *= 0.5;
+  }
+  return 0.5 * (a + b);
+}
+
+/// Seed 000 Sec. 6, the concave corner: a ruled fillet half clipped by the stitch plane Pi
+/// (through o, n its normal): each of its faces w = 0 (on S^_i) and w = 1 (on S_b) becomes
+/// F(u(s, v), v), u running from where F's v-iso crosses Pi (a(v), interpolated at the Greville
+/// points of a cubic space, spans doubled until F(a(v), v) is within tol of Pi) to the far end
+/// (fillet/compose.hpp's sub-region with the ruled map between (a(v), v) and (u_far, v):
+/// composed, or fitted to tol), and the cell is ruled between them again (Alg. 2): the cut
+/// rulings from the clipped S^_i to the clipped S_b lie in Pi at s = 0. `end` is the cell's end at
+/// the corner (u0 or u1); the result keeps u's direction.
+Trivariate clip_half(const Trivariate& h, spline::Face end, const Vec& o, const Vec& n, double side, double tol) {
+  const auto du = h.domain(0);
+  const double near = end == spline::Face::u0 ? du[0] : du[1], far = end == spline::Face::u0 ? du[1] : du[0];
+  std::array<Surface, 2> cut;
+  for (std::size_t wf = 0; wf < 2; ++wf) {
+    const Surface f = spline::boundary_face(h, wf == 0 ? spline::Face::w0 : spline::Face::w1);  // (u, v)
+    const auto dv = f.domain(1);
+    Curve a;
+    bool ok = false;
+    for (int spans = 4; spans <= 512 && !ok; spans *= 2) {
+      const KnotVector kv = KnotVector::uniform(4, spans, dv[0], dv[1]);
+      const std::vector<double> gr = kv.greville();
+      std::vector<double> val;
+      for (double v : gr) val.push_back(plane_root(f, v, o, n, side, near, far));
+      a = spline::interpolate_curve(gr, 1, val, kv);
+      double worst = 0.0;
+      for (std::size_t j = 0; j + 1 < gr.size(); ++j)
+        for (const double t : {0.25, 0.5, 0.75}) {
+          const double v = gr[j] + t * (gr[j + 1] - gr[j]);
+          const double u = std::clamp(a.eval({v})[0], std::min(near, far), std::max(near, far));
+          const double want = plane_root(f, v, o, n, side, near, far);
+          worst = std::max(worst, norm(sub(xyz(f.eval({u, v})), xyz(f.eval({want, v})))));
+        }
+      ok = worst <= 0.1 * tol;
+    }
+    if (!ok)
+      throw Error("fillet stitch at " + at(o) + ": the stitch plane's trace on the fillet does not reach the tolerance " +
+                      num(tol) + " with 512 spans",
+                  ErrorKind::failed);
+    // The map's curves in one cubic space: (a(v), v) and (u_far, v), v by its Greville points.
+    const KnotVector& kv = a.knots(0);
+    const std::vector<double> gr = kv.greville();
+    std::vector<double> pa, pf;
+    for (int i = 0; i < kv.size(); ++i) {
+      const double ai = std::clamp(a.point(i)[0], std::min(near, far), std::max(near, far));
+      pa.insert(pa.end(), {ai, gr[static_cast<std::size_t>(i)]});
+      pf.insert(pf.end(), {far, gr[static_cast<std::size_t>(i)]});
+    }
+    const Curve ca({kv}, 2, std::move(pa)), cf({kv}, 2, std::move(pf));
+    SubregionOptions so;
+    so.tolerance = 0.25 * tol;
+    // s from the clipped end towards the far one along u's own direction.
+    const Surface y = end == spline::Face::u0 ? subregion(f, ca, cf, so) : subregion(f, cf, ca, so);  // (v, s)
+    cut[wf] = spline::swap_directions(y, 0, 1);
+  }
+  Trivariate out = construct::ruled(cut[0], cut[1]);
+  if (jacobian_at(out, {0.5, 0.5, 0.5}) * jacobian_at(h, {0.5 * (du[0] + du[1]), 0.5, 0.5}) < 0.0)
+    throw Error("fillet stitch at " + at(o) + ": the clipped fillet turned inside out", ErrorKind::failed);
+  return out;
+}
+
+/// A clipped or stitched piece's fillet: det J at interior samples, volumes and the halves' glue
+/// again (the gaps to the faces, the G1 angle and the property jump stay those of the unclipped
+/// fillet, of which the clipped cells are the part beyond the stitch plane, refitted to a quarter
+/// of the tolerance).
+void remeasure(Fillet& fl) {
+  FilletQuality& q = fl.quality;
+  q.cell_jacobian.clear();
+  q.cell_volume.clear();
+  q.det_min = std::numeric_limits<double>::infinity();
+  q.det_max = -q.det_min;
+  for (const Trivariate& h : fl.cells) {
+    std::array<double, 2> r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+    const auto dv = h.domain(1), dw = h.domain(2);
+    for (const double u : u_samples(h))
+      for (int b = 0; b < 6; ++b)
+        for (int c = 0; c < 4; ++c) {
+          const double det = jacobian_at(h, {u, dv[0] + (dv[1] - dv[0]) * (b + 0.5) / 6, dw[0] + (dw[1] - dw[0]) * (c + 0.5) / 4});
+          r[0] = std::min(r[0], det);
+          r[1] = std::max(r[1], det);
+        }
+    q.cell_jacobian.push_back(r);
+    q.cell_volume.push_back(std::abs(boundary_volume(h)));
+    q.det_min = std::min(q.det_min, r[0]);
+    q.det_max = std::max(q.det_max, r[1]);
+  }
+  q.glue = face_gaps(spline::boundary_face(fl.cells.at(0), spline::Face::v1), spline::boundary_face(fl.cells.at(1), spline::Face::v0))[0];
+  q.cells.clear();
+  for (const Trivariate& h : fl.cells) {
+    SplineShape sh;
+    for (int d = 0; d < 3; ++d) sh.orders.push_back(h.orders()[static_cast<std::size_t>(d)]), sh.counts.push_back(h.count(d));
+    q.cells.push_back(sh);
+  }
+  q.fillet = q.cells.front();
 }
 
 Vec eval3(const Surface& s, const Curve& c, double t, Vec* tangent = nullptr) {
@@ -523,9 +724,16 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
     jn.r = scale(axpy(ea.rail[1 - gs], 1.0, eb.rail[1 - gs]), 0.5);
     const Vec pq = sub(jn.q, jn.p);
     const double sa = dot(pq, ta), sb = dot(pq, tb);
-    if (sa < 0.0 && sb < 0.0)
-      throw Error(where + ": a concave corner (the rails on " + (*sides[gs])[pa.face[gs]].name +
-                  " cross); expected convex corners (seed 000 Sec. 6 leaves concave C1 discontinuities to future work)");
+    if (sa < 0.0 && sb < 0.0) {
+      // Sec. 6: "concave discontinuities could be similarly handled ... with C1 discontinuities
+      // on the fillet surface, along the trimmed location": clipped and stitched below.
+      if (pa.face[gs] != pb.face[gs])
+        throw Error(where + ": a concave corner whose rails cross on two faces (" + (*sides[gs])[pa.face[gs]].name +
+                    " and " + (*sides[gs])[pb.face[gs]].name +
+                    "); expected the corner inside one face of the smooth body (clipping across faces is not supported)");
+      jn.kind = JunctionKind::stitch;
+      continue;
+    }
     if (!(sa > 0.0 && sb > 0.0))
       throw Error(where + ": the rails' ends p " + at(jn.p) + " and q " + at(jn.q) +
                   " are neither apart nor crossing; expected a convex corner");
@@ -538,6 +746,89 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
                   " from the corner; expected " + num(d));
   }
   out.junctions = std::move(junctions);
+  // Step 1b (Sec. 6, concave corners): clip the two pieces at the stitch plane and stitch them.
+  for (Junction& jn : out.junctions) {
+    if (jn.kind != JunctionKind::stitch) continue;
+    const std::size_t gs = static_cast<std::size_t>(jn.gap_side);
+    std::array<FilletPiece*, 2> pc{&out.pieces[jn.piece[0]], &out.pieces[jn.piece[1]]};
+    const std::string where = "fillet corner at " + at(jn.o) + " between " + piece_name(*pc[0], side1, side2) + " and " +
+                              piece_name(*pc[1], side1, side2);
+    for (const FilletPiece* p : pc)
+      if (p->fillets.size() != 1)
+        throw Error(where + ": a concave corner next to a piece of " + std::to_string(p->fillets.size()) +
+                    " fillets (matched pieces); expected one fillet per piece to clip (use \"method\": \"fit\")");
+    // X: where the gap side's rails cross on the shared face, from the rails' ends at o.
+    const SideFace& fg = (*sides[gs])[pc[0]->face[gs]];
+    const Surface sg = spline::boundary_face(*fg.cell, fg.face);
+    const Curve& ra = pc[0]->fillets[0].rails.rails[gs].rail;
+    const Curve& rb = pc[1]->fillets[0].rails.rails[gs].rail;
+    double s = jn.end[0], t = jn.end[1];
+    if (!rails_cross(ra, rb, s, t))
+      throw Error(where + ": a concave corner whose rails on " + fg.name +
+                  " do not cross within both pieces; expected distances that keep the crossing inside them");
+    const auto xa = ra.eval({s});
+    jn.x = point_at(sg, {xa[0], xa[1]});
+    jn.crossing = {s, t};
+    const Vec nrm = unit(cross(sub(jn.x, jn.o), sub(jn.r, jn.o)));
+    if (!(norm(nrm) > 0.0))
+      throw Error(where + ": the rails' crossing " + at(jn.x) + ", o and r " + at(jn.r) +
+                  " are collinear; expected a stitch plane through them");
+    // Clip both pieces at Pi, keeping the side of each piece's far end.
+    std::array<spline::Face, 2> ends{};
+    for (std::size_t k = 0; k < 2; ++k) {
+      Fillet& fl = pc[k]->fillets[0];
+      const Trivariate& h0 = fl.cells.at(0);
+      const auto du = h0.domain(0), dv = h0.domain(1), dw = h0.domain(2);
+      const Vec c0 = xyz(h0.eval({du[0], dv[1], dw[0]})), c1 = xyz(h0.eval({du[1], dv[1], dw[0]}));  // C's ends
+      ends[k] = norm(sub(c0, jn.o)) <= norm(sub(c1, jn.o)) ? spline::Face::u0 : spline::Face::u1;
+      const Vec farc = ends[k] == spline::Face::u0 ? c1 : c0;
+      const double side = dot(sub(farc, jn.o), nrm) > 0.0 ? 1.0 : -1.0;
+      for (auto& h : fl.cells) h = clip_half(h, ends[k], jn.o, nrm, side, tol);
+      auto& e = pc[k]->ends[static_cast<std::size_t>(jn.end[k])];
+      e.rail[gs] = jn.x;
+      e.rail_uv[gs] = {xa[0], xa[1]};
+    }
+    jn.stitch_ends = ends;
+  }
+  // The stitches, once every piece is clipped at both ends (a clip refits the whole piece): both
+  // clipped ends lie in Pi; the second piece's end is pinned onto the first's.
+  for (Junction& jn : out.junctions) {
+    if (jn.kind != JunctionKind::stitch) continue;
+    std::array<FilletPiece*, 2> pc{&out.pieces[jn.piece[0]], &out.pieces[jn.piece[1]]};
+    const std::array<spline::Face, 2> ends = jn.stitch_ends;
+    for (std::size_t c = 0; c < 2; ++c) {
+      const auto g = face_gaps(spline::boundary_face(pc[1]->fillets[0].cells[c], ends[1]),
+                               spline::boundary_face(pc[0]->fillets[0].cells[c], ends[0]));
+      jn.glue_before = std::max(jn.glue_before, g[0]);
+    }
+    if (!(jn.glue_before <= jt))
+      throw Error("fillet corner at " + at(jn.o) + " between " + piece_name(*pc[0], side1, side2) + " and " +
+                  piece_name(*pc[1], side1, side2) + ": the clipped fillets' end sections in the stitch plane through o, the rails' crossing " +
+                  at(jn.x) + " and r " + at(jn.r) + " lie " + num(jn.glue_before) +
+                  " apart; expected a corner symmetric about that plane (one straight edge, perpendicular to the face, "
+                  "equal angles; seed 000 Sec. 6)");
+    {
+      // The first piece's cells are refined into the common space as well (exactly): a copy,
+      // so that its layers stay untouched.
+      std::vector<Trivariate> first = pc[0]->fillets[0].cells;
+      pin_end(pc[1]->fillets[0].cells, -1, ends[1], first, ends[0]);
+    }
+  }
+  // The glue once every stitch is made (a piece may be stitched at both ends), and the pieces'
+  // cells measured again.
+  for (Junction& jn : out.junctions) {
+    if (jn.kind != JunctionKind::stitch) continue;
+    std::array<FilletPiece*, 2> pc{&out.pieces[jn.piece[0]], &out.pieces[jn.piece[1]]};
+    jn.glue = 0.0;
+    for (std::size_t c = 0; c < 2; ++c)
+      jn.glue = std::max(jn.glue, face_gaps(spline::boundary_face(pc[1]->fillets[0].cells[c], jn.stitch_ends[1]),
+                                            spline::boundary_face(pc[0]->fillets[0].cells[c], jn.stitch_ends[0]))[0]);
+  }
+  for (std::size_t k = 0; k < out.pieces.size(); ++k)
+    if (std::any_of(out.junctions.begin(), out.junctions.end(), [&](const Junction& j) {
+          return j.kind == JunctionKind::stitch && (j.piece[0] == k || j.piece[1] == k);
+        }))
+      remeasure(out.pieces[k].fillets[0]);
   if (!co.bridge) return out;
   // Step 2: the bridging fillets (Sec. 6.1).
   for (std::size_t jidx = 0; jidx < out.junctions.size(); ++jidx) {
@@ -570,18 +861,60 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
                      piece_name(pb, side1, side2));
     }
     cf.junction = jidx;
-    // C0 glue: the bridge's end faces against the neighbours' end faces at the same (v, w),
-    // cell for cell (both are ruled halves: v from the rail to C, w from S^_i to S_b); the
-    // pair of ends (u0 or u1 of each) that fits best is the junction.
+    // C0 glue (Sec. 6.1: the bridge meets its neighbours along their end sections): the
+    // bridge's end faces against the neighbours' end faces at the same (v, w), cell for cell
+    // (both are ruled halves: v from the rail to C, w from S^_i to S_b); the pair of ends (u0 or
+    // u1 of each) that fits best is the junction. Measured, then pinned (pin_end) and measured
+    // again: glue_before is what the bridge's own fit and section left, glue what remains.
+    std::array<spline::Face, 2> taken{spline::Face::v0, spline::Face::v0};
     for (std::size_t side = 0; side < 2; ++side) {
-      const FilletPiece& nb = side == 0 ? pa : pb;
+      FilletPiece& nb = out.pieces[jn.piece[side]];
       double best = std::numeric_limits<double>::infinity();
-      for (const Fillet& fl : nb.fillets)
+      Fillet* best_f = nullptr;
+      spline::Face best_n = spline::Face::u0, best_b = spline::Face::u0;
+      std::array<double, 2> best_jump{};
+      for (Fillet& fl : nb.fillets)
         for (spline::Face fn : {spline::Face::u0, spline::Face::u1})
-          for (spline::Face fb : {spline::Face::u0, spline::Face::u1})
-            best = std::min(best, std::max(face_gap(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn)),
-                                           face_gap(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn))));
-      cf.quality.glue[side] = best;
+          for (spline::Face fb : {spline::Face::u0, spline::Face::u1}) {
+            if (fb == taken[0]) continue;  // the other end of the bridge is the other neighbour's
+            const auto g0 = face_gaps(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn));
+            const auto g1 = face_gaps(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn));
+            const double g = std::max(g0[0], g1[0]);
+            if (g < best) best = g, best_f = &fl, best_n = fn, best_b = fb, best_jump = {g0[1], g1[1]};
+          }
+      cf.quality.glue_before[side] = best;
+      cf.quality.property_jump_before[side] = std::max(best_jump[0], best_jump[1]);
+      if (best_f == nullptr || !(best <= jt))
+        throw Error("fillet corner at " + at(jn.o) + ": the bridge's end section lies " + num(best) +
+                        " from the neighbour " + piece_name(nb, side1, side2) + "'s; expected at most the join tolerance " +
+                        num(jt),
+                    ErrorKind::failed);
+      taken[side] = best_b;
+      cf.ends[side] = best_b;
+      if (side == 0) exact_singular_rows(cf.cells, gs);
+      pin_end(cf.cells, static_cast<int>(gs), best_b, best_f->cells, best_n);
+      std::array<double, 2> after{};
+      for (std::size_t c = 0; c < 2; ++c) {
+        const auto g = face_gaps(spline::boundary_face(cf.cells[c], best_b), spline::boundary_face(best_f->cells.at(c), best_n));
+        after = {std::max(after[0], g[0]), std::max(after[1], g[1])};
+      }
+      cf.quality.glue[side] = after[0];
+      cf.quality.property_jump[side] = after[1];
+    }
+    measure_cells(cf);
+    // The rail's ends after pinning: the neighbours' rail ends, p and q.
+    {
+      // The half on S_g: its face v = 0 (half 0) or v = 1 (half 1) collapses onto the rail.
+      const Trivariate& h = cf.cells[gs];
+      const auto du = h.domain(0), dv = h.domain(1), dw = h.domain(2);
+      const double v = dv[gs];
+      double e = 0.0;
+      for (std::size_t side = 0; side < 2; ++side) {
+        const double u = du[cf.ends[side] == spline::Face::u0 ? 0 : 1];
+        const Vec want = side == 0 ? jn.p : jn.q;
+        e = std::max(e, norm(sub(xyz(h.eval({u, v, dw[0]})), want)));
+      }
+      cf.quality.end_error = std::max(cf.quality.end_error, e);
     }
     out.corners.push_back(std::move(cf));
   }

@@ -510,6 +510,17 @@ std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOpe
     for (std::size_t c = 0; c < 2; ++c) cells.emplace_back(rep.cell_names[c], cf.cells[c]);
     out.corners.push_back(std::move(rep));
   }
+  for (const auto& jn : mf.junctions) {
+    if (jn.kind != fillet::JunctionKind::stitch) continue;
+    StitchBuild rep;
+    rep.name = op.name;
+    rep.pointer = op.pointer;
+    rep.pieces = {piece_name(mf.pieces[jn.piece[0]]), piece_name(mf.pieces[jn.piece[1]])};
+    const std::size_t g = static_cast<std::size_t>(jn.gap_side);
+    rep.faces = {sides[g][mf.pieces[jn.piece[0]].face[g]].name, sides[1 - g][mf.pieces[jn.piece[0]].face[1 - g]].name};
+    rep.junction = jn;
+    out.stitches.push_back(std::move(rep));
+  }
   return cells;
 }
 

@@ -12,9 +12,11 @@
 #   cylinder cells' sides against three box faces) and four convex corners at (0, +-8, 0) and
 #   (0, +-8, -10), where the box's edges (along y, perpendicular to the cylinder there) cross
 #   the cylinder; p and q are 2 from o on the cylinder, r = o +- (0, 2, 0) on the edge; det J > 0
-#   inside; the bridges glue to their neighbours within the fit tolerance;
-# - bad input exits 2 naming the place: a concave corner (the plate's rails flipped into the
-#   footprint cross), faces that do not meet, "corners" without face lists, the flend section or
+#   inside; the bridges are pinned to their neighbours' end sections: glue at rounding level,
+#   no property jump, and `trivox validate` finds no cell invalid;
+# - the concave corner of an L-shaped prism on a plate (models/l_notch.json, below): stitched;
+# - bad input exits 2 naming the place: a concave corner whose rails cross beyond the pieces,
+#   faces that do not meet, "corners" without face lists, the flend section or
 #   the VBS construction with corners, a bad face name in a list.
 set -euo pipefail
 source tests/cli/lib.bash "$@"
@@ -54,7 +56,8 @@ for c in k:
     assert abs(c["angle"] - math.pi / 2) < 1e-9, c["angle"]
     assert c["gap_face"] == "plate/w1" and c["edge_face"].startswith("column/"), c
     assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
-    assert max(c["glue"]) < 1e-5 and c["g1_angle"] < 1e-5, (c["glue"], c["g1_angle"])
+    assert max(c["glue"]) < 1e-12 and max(c["glue_before"]) < 1e-5 and c["g1_angle"] < 1e-5, (c["glue"], c["g1_angle"])
+    assert max(c["property_jump"]) < 1e-12, c["property_jump"]
 vol = {x["name"]: x["volume"] for x in r["cells"]}
 pieces = sum(v for n, v in vol.items() if n.startswith("ring.") and not n.startswith("ring.c"))
 bridges = sum(v for n, v in vol.items() if n.startswith("ring.c"))
@@ -98,18 +101,88 @@ for c in k:
     assert abs(c["angle"] - math.pi / 2) < 1e-2, c["angle"]
     assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
     assert max(c["end_error"], c["o_error"], c["r_error"], c["radius_error"]) < 1e-4, c
-    assert max(c["glue"]) < 1e-4 and c["g1_angle"] < 1e-3, (c["glue"], c["g1_angle"])
-    print(f"corner {o[0]:+.4f} {o[1]:+.4f} {o[2]:+.4f}: glue {max(c['glue']):.2e}, G1 {c['g1_angle']:.2e}, "
+    # Pinned to the neighbours' end sections (Sec. 6.1's C0 glue): rounding level, far below the
+    # fillet tolerance 1e-7 * diagonal (5.9e-6); before pinning, the two fits' difference.
+    tol = 5.9e-6  # 1e-7 of the listed cells' bounding-box diagonal
+    assert max(c["glue"]) < 1e-3 * tol and c["g1_angle"] < 1e-3, (c["glue"], c["g1_angle"])
+    assert max(c["glue_before"]) < 1e-4 and max(c["property_jump"]) < 1e-12, (c["glue_before"], c["property_jump"])
+    print(f"corner {o[0]:+.4f} {o[1]:+.4f} {o[2]:+.4f}: glue {max(c['glue']):.2e} (before pinning "
+          f"{max(c['glue_before']):.2e}), property jump {max(c['property_jump_before']):.2e} -> "
+          f"{max(c['property_jump']):.2e}, G1 {c['g1_angle']:.2e}, "
           f"det J {c['min_jacobian']:.3e}..{c['max_jacobian']:.3e}, volume {sum(c['cell_volume']):.6f}")
 assert seen == {(8, 0), (-8, 0), (8, -10), (-8, -10)}, seen
+PY
+# Pinning keeps the bridges' singular structure exact: no cell is found invalid (det J < 0 at a
+# point), the segment halves are proven degenerate (det J = 0 on the edge o r, > 0 inside).
+"$trivox" validate "$tmp/bc.model.json" --json > "$tmp/bc.validate.json" || true
+"$py" - "$tmp/bc.validate.json" <<'PY'
+import sys, json
+r = json.load(open(sys.argv[1]))
+for c in r["cells"]:
+    assert c["verdict"] != "invalid", c
+    if c["name"].startswith("ring.c") and c["name"].endswith("b"):
+        assert c["verdict"] == "degenerate", c
 PY
 # Next to the corner (0, 8, 0), outside the box (x > 0, z > 0) and the cylinder: in a bridge.
 cell=$(loc "$tmp/bc.model.json" 0.3,8.3,0.3)
 case $cell in ring.c*) ;; *) echo "by the corner (0, 8, 0): in '$cell', expected a bridge cell ring.c*"; exit 1 ;; esac
 
+# Sec. 6's concave corner (models/l_notch.json): an L-shaped prism of three unit boxes on a plate,
+# d = (0.5, 0.25), tau 1. C has eight unit pieces, five convex corners (bridged), two G1 joins
+# and the concave corner o = (1, 1, 0), where the plate's rails y = 1.5 and x = 1.5 cross at
+# x = (1.5, 1.5, 0) and the arms' rails meet on the reflex edge at r = (1, 1, 0.25). The two
+# pieces there are clipped by the plane x = y through o, x and r and stitched: each is the
+# Hermite section R swept along 1 and cut by that plane, int_R (1 - X) dA (X the distance from
+# the edge); the six others are R swept along 1, the bridges Pappus' quarter turns.
+"$trivox" build models/l_notch.json -o "$tmp/notch.model.json" --json > "$tmp/notch.build.json"
+"$py" - "$tmp/notch.build.json" <<'PY'
+import sys, json, math
+sys.path.insert(0, "tests/cli")
+from fillet_math import hermite_area, hermite_moment
+r = json.load(open(sys.argv[1]))
+assert r["valid"], "every cell valid"
+d1, d2, tau = 0.5, 0.25, 1.0
+area, moment = hermite_area(d1, d2, tau), hermite_moment(d1, d2, tau)
+f, k, st = r["fillets"], r["corners"], r["stitches"]
+assert len(f) == 8 and len(k) == 5 and len(st) == 1, (len(f), len(k), len(st))
+s = st[0]
+assert math.dist(s["o"], [1, 1, 0]) < 1e-9 and math.dist(s["x"], [1 + d1, 1 + d1, 0]) < 1e-9, s
+assert math.dist(s["r"], [1, 1, d2]) < 1e-9 and abs(s["angle"] - math.pi / 2) < 1e-9, s
+assert s["crossing_face"] == "plate/w1" and s["glue"] < 1e-12 and s["glue_before"] < 1e-6, s
+for x in f:
+    assert x["jacobian"] == "positive", (x["between"], x["jacobian"])
+vol = {x["name"]: x["volume"] for x in r["cells"]}
+clipped = {p.split(" x ")[1] for p in s["pieces"]}
+assert clipped == {"arm_y/u1", "arm_x/v1"}, clipped
+pieces = {}
+for n, x in enumerate(f, 1):
+    pieces[x["between"][1]["cell"] + "/" + x["between"][1]["face"]] = vol[f"ring.{n}a"] + vol[f"ring.{n}b"]
+for face, v in pieces.items():
+    want = area - moment if face in clipped else area
+    assert abs(v - want) < 1e-6 * want, (face, v, want)
+bridges = sum(v for n, v in vol.items() if n.startswith("ring.c"))
+want_b = 5 * math.pi / 2 * moment
+assert abs(bridges - want_b) < 1e-5 * want_b, (bridges, want_b)
+for c in k:
+    assert max(c["glue"]) < 1e-12 and c["jacobian"] == "positive", c
+print(f"notch: clipped pieces {sorted(v for f_, v in pieces.items() if f_ in clipped)} (exact {area - moment:.9f}), "
+      f"bridges {bridges:.9f} (Pappus {want_b:.9f}), stitch glue {s['glue']:.1e} (before {s['glue_before']:.1e})")
+PY
+# Between the arms, 0.05 above the plate on the diagonal: in a clipped piece's cell.
+cell=$(loc "$tmp/notch.model.json" 1.1,1.1,0.05)
+case $cell in ring.4?|ring.5?) ;; *) echo "in the notch: in '$cell', expected a clipped piece ring.4* or ring.5*"; exit 1 ;; esac
+
 # Bad input: exit 2, the place named.
-column_scene "$tmp/bad.json" ', "flip": [true, false]'
-expect_fail '/operations/0: fillet corner at (.*concave corner' "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
+"$py" - models/l_notch.json "$tmp/bad.json" <<'PY'
+import sys, json
+m = json.load(open(sys.argv[1]))
+op = m["operations"][0]
+op["between"][1] = [{"cell": "arm_y", "face": "u1"}, {"cell": "arm_x", "face": "v1"}]
+op["distance"] = [1.5, 0.25]  # the plate's rails would cross at (2.5, 2.5), past the unit arms
+json.dump(m, open(sys.argv[2], "w"))
+PY
+expect_fail '/operations/0: fillet corner at (.*a concave corner whose rails on plate/w1 do not cross within both pieces' \
+  "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
 column_scene "$tmp/bad.json" "" '{"cell": "column", "face": "w1"}, {"cell": "column", "face": "w0"}'
 expect_fail '/operations/0: fillet across faces: the faces plate/w1 and column/w1, column/w0 do not intersect' \
   "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"

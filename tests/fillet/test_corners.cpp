@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "corner.hpp"
@@ -89,8 +90,15 @@ TEST_CASE("fillet across a column's faces: Sec. 6 pieces and Sec. 6.1 bridges at
     CHECK(q.r_error < 1e-9);    // the section ends at r
     CHECK(q.radius_error < tol);
     CHECK(q.g1_angle < 1e-5);
-    CHECK(q.glue[0] < 10 * tol);  // C0 with both neighbours
-    CHECK(q.glue[1] < 10 * tol);
+    // C0 with both neighbours: pinned to their end sections, so one function (rounding level);
+    // before pinning the bridge's own section ended within the fit tolerance of theirs.
+    CHECK(q.glue[0] < 1e-12);
+    CHECK(q.glue[1] < 1e-12);
+    CHECK(q.glue_before[0] < 10 * tol);
+    CHECK(q.glue_before[1] < 10 * tol);
+    CHECK(q.property_jump[0] < 1e-12);  // g_1 = 1 and g_2 = 2 on both sides of the glue
+    CHECK(q.property_jump[1] < 1e-12);
+    CHECK(cf.ends[0] != cf.ends[1]);
     const double v = q.cell_volume[0] + q.cell_volume[1];
     CHECK(v == Approx(bridge_volume).epsilon(1e-5));
     total += v;
@@ -124,19 +132,110 @@ TEST_CASE("fillet across faces: gaps left open without bridges (Fig. 12 (c))", "
   CHECK(m.corners.empty());
 }
 
+namespace {
+
+/// An L-shaped footprint's concave corner at (1, 1): boxes A = [1,2] x [0,1] and B = [0,1] x
+/// [1,2] (the L's arms) standing on the plate; their faces y = 1 (A's v1, x in [1, 2]) and x = 1
+/// (B's u1, y in [1, 2]) meet at the reflex edge x = y = 1, perpendicular to the plate.
+struct Notch {
+  spline::Trivariate plate = box_cell({-4, -4, -2}, {4, 4, 0}, 1.0);
+  spline::Trivariate a = box_cell({1, 0, -1}, {2, 1, 3}, 2.0);
+  spline::Trivariate b = box_cell({0, 1, -1}, {1, 2, 3}, 2.0);
+  std::vector<fillet::SideFace> side1{{&plate, spline::Face::w1, "plate/w1"}};
+  std::vector<fillet::SideFace> side2{{&a, spline::Face::v1, "a/v1"}, {&b, spline::Face::u1, "b/u1"}};
+};
+
+}  // namespace
+
+TEST_CASE("fillet across faces: a concave corner, rails clipped and stitched (Sec. 6, Fig. 12 (b))", "[fillet][corners]") {
+  Notch c;
+  fillet::FilletOptions o;
+  const double d1 = 0.5, d2 = 0.25, tau = 1.0;
+  o.distance = {d1, d2};
+  o.blend.tau = tau;
+  const auto m = fillet::fillet_across(c.side1, c.side2, o);
+  REQUIRE(m.pieces.size() == 2);
+  CHECK_FALSE(m.closed);
+  REQUIRE(m.junctions.size() == 1);
+  CHECK(m.corners.empty());
+  const auto& j = m.junctions[0];
+  CHECK(j.kind == fillet::JunctionKind::stitch);
+  CHECK(j.gap_side == 0);
+  // The plate's rails y = 1 + d1 (A) and x = 1 + d1 (B) cross at (1 + d1, 1 + d1, 0); the arms'
+  // rails meet on the edge at r = (1, 1, d2).
+  CHECK(std::hypot(j.x[0] - (1 + d1), j.x[1] - (1 + d1), j.x[2]) < 1e-9);
+  CHECK(std::hypot(j.o[0] - 1, j.o[1] - 1, j.o[2]) < 1e-9);
+  CHECK(std::hypot(j.r[0] - 1, j.r[1] - 1, j.r[2] - d2) < 1e-9);
+  // The crossing's parameters: d1 along each unit-length rail from the corner's end.
+  for (std::size_t k = 0; k < 2; ++k) {
+    const double t = j.crossing[k], e = j.end[k];
+    CHECK(std::abs(t - e) > 0.0);
+    CHECK(std::abs(t - e) < 1.0);
+  }
+  const double tol = 1e-7 * std::sqrt(8 * 8 + 8 * 8 + 5 * 5);
+  CHECK(j.glue_before < 10 * tol);  // both clipped ends lie in the plane x = y, the mirror of each other
+  CHECK(j.glue < 1e-12);            // stitched: the second's end pinned onto the first's
+  // Each piece is the Hermite section R swept along its unit-length arm, cut by the plane x = y:
+  // int_R (1 - X) dA, X the distance from the edge.
+  const double want = hermite_area(d1, d2, tau) - hermite_moment(d1, d2, tau);
+  for (const auto& p : m.pieces) {
+    REQUIRE(p.fillets.size() == 1);
+    const auto& q = p.fillets[0].quality;
+    CHECK(q.jacobian() == "positive");
+    CHECK(q.det_min > 0.0);
+    CHECK(q.cell_volume[0] + q.cell_volume[1] == Approx(want).epsilon(1e-6));
+    CHECK(q.glue < 10 * tol);
+    // The clipped end in the stitch plane x = y, the kept part on the arm's side.
+    for (const auto& h : p.fillets[0].cells) {
+      const auto du = h.domain(0);
+      double in_plane = std::numeric_limits<double>::infinity(), off = 0.0;
+      for (const double u : {du[0], du[1]}) {
+        double worst = 0.0;
+        for (int a = 0; a <= 8; ++a)
+          for (int b = 0; b <= 8; ++b) {
+            const auto x = h.eval({u, a / 8.0, b / 8.0});
+            worst = std::max(worst, std::abs(x[0] - x[1]));
+          }
+        in_plane = std::min(in_plane, worst);
+        off = std::max(off, worst);
+      }
+      CHECK(in_plane < 10 * tol);
+      CHECK(off > 0.5);  // the far end stays at x = 2 (or y = 2)
+    }
+  }
+}
+
+TEST_CASE("fillet across faces: the plate's rails flipped into the column's footprint cross at four concave corners",
+          "[fillet][corners]") {
+  Column c;
+  fillet::FilletOptions o;
+  o.distance = {0.5, 0.5};
+  o.flip = {true, false};
+  const auto m = fillet::fillet_across(c.side1, c.side2, o);
+  REQUIRE(m.junctions.size() == 4);
+  CHECK(m.corners.empty());
+  for (const auto& j : m.junctions) {
+    CHECK(j.kind == fillet::JunctionKind::stitch);
+    // The rails x = +-0.5 and y = +-0.5 inside the square cross at (+-0.5, +-0.5, 0).
+    CHECK(std::hypot(std::abs(j.x[0]) - 0.5, std::abs(j.x[1]) - 0.5, j.x[2]) < 1e-9);
+    CHECK(j.glue < 1e-12);
+  }
+}
+
 TEST_CASE("fillet across faces: bad input names the place", "[fillet][corners]") {
   Column c;
   fillet::FilletOptions o;
   o.distance = {1.0, 0.5};
-  SECTION("a concave corner: the plate's rails inside the footprint cross") {
-    o.flip = {true, false};
+  SECTION("a concave corner whose rails cross beyond the pieces") {
+    Notch n;
+    o.distance = {1.5, 0.25};  // the plate's rails would cross at (2.5, 2.5), past the unit arms
     try {
-      (void)fillet::fillet_across(c.side1, c.side2, o);
+      (void)fillet::fillet_across(n.side1, n.side2, o);
       FAIL("no error");
     } catch (const Error& e) {
       CHECK(e.kind() == trivox::ErrorKind::bad_input);
-      CHECK_THAT(e.what(), Catch::Contains("concave corner") && Catch::Contains("plate/w1 x column/") &&
-                               Catch::Contains("fillet corner at ("));
+      CHECK_THAT(e.what(), Catch::Contains("concave corner") && Catch::Contains("plate/w1 x ") &&
+                               Catch::Contains("do not cross within both pieces") && Catch::Contains("fillet corner at ("));
     }
   }
   SECTION("faces that do not meet") {

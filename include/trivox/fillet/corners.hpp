@@ -17,10 +17,10 @@
 ///   a convex corner, bridged as below (Sec. 6.1); with the tangents t_a (arriving at o) and t_b
 ///   (leaving o) of C, convex means (q - p) . t_a > 0 and (q - p) . t_b > 0 (Fig. 12 (b)-(c));
 /// - the gap side's rails cross instead ((q - p) . t_a < 0 and (q - p) . t_b < 0): a concave
-///   corner, which Sec. 6 leaves to future work: Error (bad_input) naming the corner;
+///   corner, clipped and stitched (below; on two faces of the smooth body: Error (bad_input));
 /// - neither side's rails meet (both bodies have an edge at o, the case Sec. 6.1 sets aside, or an
 ///   edge not perpendicular to the other face, whose rails would have to be clipped at the
-///   edge): Error (bad_input) naming the corner.
+///   edge: not done yet): Error (bad_input) naming the corner.
 ///
 /// Step 2 (Sec. 6.1), the bridging fillet at a convex corner. The extracted text is garbled in
 /// two places; what follows is the construction derived from the surrounding text and Fig. 12:
@@ -54,6 +54,37 @@
 ///   ruled halves (Alg. 2, fillet/ruled_fillet.hpp, properties by Sec. 7.1) glue C0 to them.
 ///   The control points of the section other than the rails are interpolated in phi at the
 ///   Greville points of the fan's knots, halved until within tolerance.
+/// - Exact glue. Built alone, the bridge's end sections equal the neighbours' only to the fits'
+///   tolerance (its fan and their sub-regions are fitted on different knots, its section is
+///   interpolated where theirs comes from blending_surface: up to twice the tolerance apart on
+///   the box and cylinder). fillet_across therefore pins them: per half, the bridge's and the
+///   neighbour's cells are brought into one (v, w) space (exact), the neighbour's end layer takes
+///   the bridge's singular rows (o, the segment o r and r, which the bridge holds the same in
+///   every layer; the neighbour moves there by its own fit error), and the bridge's end layer of
+///   control points becomes the neighbour's. The end faces are then one function, xyz and
+///   properties: glue and property jump at rounding level (CornerQuality::glue, property_jump;
+///   glue_before, property_jump_before: what pinning removed).
+///
+/// Step 1b (Sec. 6, Fig. 12 (b)), the stitch at a concave corner. The text: "concave
+/// discontinuities could be similarly handled ... while it would result with C1 discontinuities
+/// on the fillet surface, along the trimmed location". Here: the crossing X of the two rails on
+/// the shared face (Newton on rail_a(s) = rail_b(t) in its parameters, from the rails' ends at
+/// o; crossing outside either piece: Error (bad_input)); the stitch plane Pi through o, X and r
+/// (the other body's rails' common end on its edge). Each piece's two ruled halves are clipped
+/// by Pi: their faces w = 0 (on S^_i) and w = 1 (on S_b) become F(u(s, v), v), u running from
+/// a(v), where F's v-iso crosses Pi (a cubic interpolant of the roots, spans doubled until within
+/// a tenth of the tolerance), to the far end (compose.hpp's sub-region of the ruled map, composed
+/// or fitted to a quarter of the tolerance), and the half is ruled between them again (Alg. 2):
+/// its end lies in Pi, its rail on S_g ends at X, on S^_i it ends on S_g's segment from X to o
+/// (its other body's on the edge o r). The two clipped ends then coincide where the corner is
+/// symmetric about Pi (a straight edge perpendicular to the face, equal distances: the blends
+/// are mirror images and cross in Pi); elsewhere their distance exceeds the join tolerance:
+/// Error (bad_input). Once every piece is clipped, the second piece's end is pinned onto the
+/// first's (as the bridges are below, without singular rows): glue at rounding level
+/// (Junction::glue, glue_before). The fillet surface is C0 there, with the C1 crease the text
+/// announces. The clipped pieces' det J, volumes and shared-face glue are measured again; their
+/// gaps to the faces and G1 angles are those of the unclipped fillets.
+///
 /// det J vanishes on the fan's edge at o and on the segment face (singular by construction, as
 /// on the rails of every ruled fillet) and is checked at interior samples.
 ///
@@ -102,7 +133,9 @@ struct FilletPiece {
   std::array<End, 2> ends{};
 };
 
-enum class JunctionKind { smooth, corner };
+/// smooth: a G1 join; corner: a convex corner, bridged (Sec. 6.1); stitch: a concave corner whose
+/// rails on the smooth face cross, both pieces clipped at the stitch plane and stitched (Sec. 6).
+enum class JunctionKind { smooth, corner, stitch };
 
 /// Where two pieces meet: piece[0] arrives at o through its end end[0], piece[1] leaves it.
 struct Junction {
@@ -115,6 +148,13 @@ struct Junction {
   int gap_side = -1;
   std::array<double, 3> o{}, p{}, q{}, r{};
   std::array<double, 2> rail_gap{};  ///< distance between the two pieces' rail ends, per side
+  /// stitch: where the gap side's rails cross (X, the clipped rails' common end), the rails'
+  /// parameters there (piece[0]'s, piece[1]'s), and the C0 glue between the two clipped ends
+  /// after stitching (glue) and before (glue_before: their distance in the stitch plane)
+  std::array<double, 3> x{};
+  std::array<double, 2> crossing{};
+  double glue = 0.0, glue_before = 0.0;
+  std::array<spline::Face, 2> stitch_ends{};  ///< stitch: the clipped cells' ends (u0 or u1) at o
 };
 
 struct CornerQuality {
@@ -127,9 +167,16 @@ struct CornerQuality {
   std::array<std::array<double, 2>, 2> cell_jacobian{};  ///< per cell: sampled det J min, max
   std::array<double, 2> cell_volume{};  ///< |int det J| per cell (divergence theorem)
   /// C0 glue: max xyz distance between the bridge's end faces (phi = 0, phi = 1) and the
-  /// neighbouring pieces' end faces at the same (v, w), cell for cell (fillet_across; 0 from
-  /// bridge_corner alone)
+  /// neighbouring pieces' end faces at the same (v, w), cell for cell, after fillet_across pinned
+  /// them (rounding level; 0 from bridge_corner alone)
   std::array<double, 2> glue{};
+  /// The same before pinning: how far the bridge's own fan fit and interpolated section ended
+  /// from the neighbours' (their fits and blending surfaces); what the pinning moved the end
+  /// layers by, in function values
+  std::array<double, 2> glue_before{};
+  /// Property jump across the glued ends: max |g_bridge - g_neighbour| (coordinates 3..k-1) on
+  /// the end faces at the same (v, w), after and before pinning (0 without properties)
+  std::array<double, 2> property_jump{}, property_jump_before{};
   std::array<int, 2> bd_samples{};  ///< samples of B_d; Greville rows of the section
   double seconds = 0.0;
   /// "positive", "negative" or "changes sign".
@@ -141,6 +188,9 @@ struct CornerQuality {
 struct CornerFillet {
   std::size_t junction = 0;  ///< into MultiFillet::junctions
   std::array<spline::Trivariate, 2> cells;
+  /// fillet_across: the cells' faces (u0 or u1) glued to the arriving piece (ends[0]) and to the
+  /// leaving one (ends[1])
+  std::array<spline::Face, 2> ends{spline::Face::u0, spline::Face::u1};
   CornerQuality quality;
 };
 

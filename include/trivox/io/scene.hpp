@@ -216,6 +216,16 @@ struct CornerBuild {
   fillet::CornerQuality quality;
 };
 
+/// A concave corner of a fillet over several faces (seed 000 Sec. 6): the two pieces clipped at
+/// the rails' crossing and stitched.
+struct StitchBuild {
+  std::string name;                   ///< the operation's result name
+  std::string pointer;                ///< "/operations/<i>"
+  std::array<std::string, 2> pieces;  ///< the two pieces, "cell/face x cell/face"
+  std::array<std::string, 2> faces;   ///< the face whose rails cross, the one with the edge
+  fillet::Junction junction;          ///< o, x (the crossing), r, glue
+};
+
 /// What one derived surface gave ("gismo" or "offset").
 struct SurfaceBuild {
   std::string name, kind;
@@ -243,6 +253,7 @@ struct SceneBuild {
   std::vector<FilletBuild> fillets;
   std::vector<BridgeBuild> bridges;
   std::vector<CornerBuild> corners;  ///< fillets over several faces: the bridging fillets
+  std::vector<StitchBuild> stitches;  ///< fillets over several faces: the stitched concave corners
 };
 
 /// Expands the primitives (named `<name>.<part>`, construct/primitives.hpp) and applies their
