@@ -278,19 +278,22 @@ private:
     // certified like any other. Outside the box a polynomial of degree n grows by at most the
     // Chebyshev factor T_n(1 + 2 delta / len) <= cosh(n sqrt(4 delta / len)).
     Vec3 out{};
-    double grow = 1.0, off = 0.0;
+    double off = 0.0;
+    const double dkn = kn, dkp = kp, dln = ln, dlp = lp;
     for (std::size_t j = 0; j < 3; ++j) {
+      // The extreme parameters over the rectangle: at its corners.
       const double base = e_->t[j] + c0_[j];
-      const double c[4] = {base - kn * dx_[j] - ln * dy_[j], base + kp * dx_[j] - ln * dy_[j], base - kn * dx_[j] + lp * dy_[j],
-                           base + kp * dx_[j] + lp * dy_[j]};
-      const double lo = std::min({c[0], c[1], c[2], c[3]}), hi = std::max({c[0], c[1], c[2], c[3]});
+      const double xa = -dkn * dx_[j], xb = dkp * dx_[j], ya = -dln * dy_[j], yb = dlp * dy_[j];
+      const double lo = base + std::min(xa, xb) + std::min(ya, yb), hi = base + std::max(xa, xb) + std::max(ya, yb);
       out[j] = std::max({0.0, hi + r[j] - b_->hi[j], b_->lo[j] - (lo - r[j])});
-      if (out[j] > 0.0) {
-        grow *= std::cosh(b_->degree[j] * std::sqrt(4.0 * out[j] / (b_->hi[j] - b_->lo[j])));
-        off += b_->slope[j] * out[j];
-      }
+      off += b_->slope[j] * out[j];
     }
     if (off > 0.0) {
+      // grow >= 1: too far out whatever the growth factor (and a larger G only reaches farther).
+      if (!(off <= tol_)) return 0;
+      double grow = 1.0;
+      for (std::size_t j = 0; j < 3; ++j)
+        if (out[j] > 0.0) grow *= std::cosh(b_->degree[j] * std::sqrt(4.0 * out[j] / (b_->hi[j] - b_->lo[j])));
       if (!(grow <= G)) return G > 1.0 ? 0 : -1;
       if (!(grow * off <= tol_)) return 0;
     }
