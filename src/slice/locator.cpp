@@ -502,64 +502,78 @@ struct CellBuild {
 };
 
 /// Subdivides a piece's parameter box (local [0,1]^3) into nearly affine leaves: deviation from
-/// affine at most 10% of the leaf's diagonal and, when `max_dev` > 0, at most max_dev.
+/// affine at most 10% of the leaf's diagonal and, when `max_dev` > 0, at most max_dev; then, when
+/// 0 < fine_dev < max_dev, on towards fine_dev with at most fine_factor times as many leaves
+/// (the most deviating split first, so a budget that runs out leaves the piece evenly refined).
 void build_leaves(const std::vector<double>& net, const std::array<int, 3>& ord, int H, double min_diag, double max_dev,
-                  int max_leaves, std::vector<std::pair<std::array<Vec3, 2>, Flatness>>& out) {
+                  double fine_dev, int fine_factor, int max_leaves, std::vector<std::pair<std::array<Vec3, 2>, Flatness>>& out) {
   constexpr double flat = 0.1;  // deviation / diagonal at which a leaf is flat enough
   struct Item {
     Vec3 lo, hi;
     std::vector<double> net;
     Flatness f;
   };
-  // Most deviating first, so a leaf budget that runs out leaves the pieces evenly refined.
   auto less = [](const Item& a, const Item& b) { return a.f.deviation < b.f.deviation; };
-  std::vector<Item> work;
-  work.push_back({{0, 0, 0}, {1, 1, 1}, net, flatness(net, ord, H)});
-  while (!work.empty()) {
-    std::pop_heap(work.begin(), work.end(), less);
-    Item it = std::move(work.back());
-    work.pop_back();
-    const bool flat_enough = it.f.deviation <= flat * it.f.diagonal && (max_dev <= 0.0 || it.f.deviation <= max_dev);
-    const bool done = flat_enough || it.f.diagonal < min_diag || static_cast<int>(out.size() + work.size()) + 2 > max_leaves;
-    if (done) {
-      out.push_back({{it.lo, it.hi}, it.f});
-      continue;
-    }
-    // Split the direction whose halves come out flattest (absolute deviation: splitting a
-    // direction along which the net is already straight leaves the deviation as it is).
-    int best = -1;
-    double best_dev = inf;
-    for (int d = 0; d < 3; ++d) {
-      if (ord[static_cast<std::size_t>(d)] < 2) continue;
-      double dev = 0.0;
+  std::vector<Item> work, done;
+  // Splits the most deviating item until every one is flat enough for dev_limit or the budget
+  // of `cap` leaves is spent.
+  auto refine = [&](double dev_limit, int cap) {
+    while (!work.empty()) {
+      std::pop_heap(work.begin(), work.end(), less);
+      Item it = std::move(work.back());
+      work.pop_back();
+      const bool flat_enough = it.f.deviation <= flat * it.f.diagonal && (dev_limit <= 0.0 || it.f.deviation <= dev_limit);
+      const bool stop = flat_enough || it.f.diagonal < min_diag || static_cast<int>(done.size() + work.size()) + 2 > cap;
+      if (stop) {
+        done.push_back(std::move(it));
+        continue;
+      }
+      // Split the direction whose halves come out flattest (absolute deviation: splitting a
+      // direction along which the net is already straight leaves the deviation as it is).
+      int best = -1;
+      double best_dev = inf;
+      for (int d = 0; d < 3; ++d) {
+        if (ord[static_cast<std::size_t>(d)] < 2) continue;
+        double dev = 0.0;
+        for (int side = 0; side < 2; ++side) {
+          Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
+          (side ? lo : hi)[static_cast<std::size_t>(d)] = 0.5;
+          dev = std::max(dev, flatness(restrict_net(it.net, ord, H, lo, hi), ord, H).deviation);
+        }
+        if (dev < best_dev) {
+          best_dev = dev;
+          best = d;
+        }
+      }
+      if (best < 0) {
+        done.push_back(std::move(it));
+        continue;
+      }
       for (int side = 0; side < 2; ++side) {
         Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
-        (side ? lo : hi)[static_cast<std::size_t>(d)] = 0.5;
-        dev = std::max(dev, flatness(restrict_net(it.net, ord, H, lo, hi), ord, H).deviation);
+        (side ? lo : hi)[static_cast<std::size_t>(best)] = 0.5;
+        Item child;
+        child.net = restrict_net(it.net, ord, H, lo, hi);
+        child.f = flatness(child.net, ord, H);
+        child.lo = it.lo;
+        child.hi = it.hi;
+        const double mid = 0.5 * (it.lo[static_cast<std::size_t>(best)] + it.hi[static_cast<std::size_t>(best)]);
+        (side ? child.lo : child.hi)[static_cast<std::size_t>(best)] = mid;
+        work.push_back(std::move(child));
+        std::push_heap(work.begin(), work.end(), less);
       }
-      if (dev < best_dev) {
-        best_dev = dev;
-        best = d;
-      }
     }
-    if (best < 0) {
-      out.push_back({{it.lo, it.hi}, it.f});
-      continue;
-    }
-    for (int side = 0; side < 2; ++side) {
-      Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
-      (side ? lo : hi)[static_cast<std::size_t>(best)] = 0.5;
-      Item child;
-      child.net = restrict_net(it.net, ord, H, lo, hi);
-      child.f = flatness(child.net, ord, H);
-      child.lo = it.lo;
-      child.hi = it.hi;
-      const double mid = 0.5 * (it.lo[static_cast<std::size_t>(best)] + it.hi[static_cast<std::size_t>(best)]);
-      (side ? child.lo : child.hi)[static_cast<std::size_t>(best)] = mid;
-      work.push_back(std::move(child));
-      std::push_heap(work.begin(), work.end(), less);
-    }
+  };
+  work.push_back({{0, 0, 0}, {1, 1, 1}, net, flatness(net, ord, H)});
+  refine(max_dev, max_leaves);
+  if (fine_dev > 0.0 && (max_dev <= 0.0 || fine_dev < max_dev) && fine_factor > 1) {
+    const int cap = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(max_leaves), done.size() * static_cast<std::size_t>(fine_factor)));
+    work = std::move(done);
+    done.clear();
+    std::make_heap(work.begin(), work.end(), less);
+    refine(fine_dev, cap);
   }
+  for (const auto& it : done) out.push_back({{it.lo, it.hi}, it.f});
 }
 
 /// Bounds on the second partials of a polynomial piece (net: nc = 3 + m coordinates per point):
@@ -728,7 +742,7 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
     // model of thousands of pieces would otherwise pay seconds here for pieces no voxel needs.
     if (pc.k.all_first) pc.bounds = step_bounds_of(all, pc, m);
     std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
-    build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.max_leaves_per_piece, lv);
+    build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
     for (const auto& [box, fl] : lv) {
       LocatorLeaf leaf;
       leaf.cell = cell_index;

@@ -27,6 +27,9 @@ LocatorOptions options_for(const VoxelGrid& grid) {
   o.tolerance = 1e-3 * pmin;
   // Leaves hugging the cells to within about a voxel: little empty space left to invert.
   o.leaf_deviation = 1.0 * std::max({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
+  // Then on towards a quarter of that, within 4 times the leaves per piece.
+  o.fine_leaf_deviation = 0.25 * o.leaf_deviation;
+  o.fine_leaf_factor = 4;
   return o;
 }
 
