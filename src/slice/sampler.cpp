@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 
 #include "trivox/error.hpp"
@@ -26,6 +27,9 @@ LocatorOptions options_for(const VoxelGrid& grid) {
   o.tolerance = 1e-3 * pmin;
   // Leaves hugging the cells to within about a voxel: little empty space left to invert.
   o.leaf_deviation = 1.0 * std::max({grid.pitch[0], grid.pitch[1], grid.pitch[2]});
+  // Then on towards a quarter of that, within 4 times the leaves per piece.
+  o.fine_leaf_deviation = 0.25 * o.leaf_deviation;
+  o.fine_leaf_factor = 4;
   return o;
 }
 
@@ -59,6 +63,13 @@ bool invert(const std::array<Vec3, 3>& J, std::array<Vec3, 3>& inv) {
 inline Vec3 mul(const std::array<Vec3, 3>& rows, const Vec3& v) {
   return {rows[0][0] * v[0] + rows[0][1] * v[1] + rows[0][2] * v[2], rows[1][0] * v[0] + rows[1][1] * v[1] + rows[1][2] * v[2],
           rows[2][0] * v[0] + rows[2][1] * v[1] + rows[2][2] * v[2]};
+}
+
+/// Whether t lies outside the box dom.
+bool beyond(const Vec3& t, const std::array<Vec3, 2>& dom) {
+  for (std::size_t d = 0; d < 3; ++d)
+    if (t[d] < dom[0][d] || t[d] > dom[1][d]) return true;
+  return false;
 }
 
 /// A leaf met by the current row: its voxel interval and warm-start state.
@@ -105,8 +116,10 @@ public:
         tol_(loc.options().tolerance), nx_(grid.count[0]) {}
 
   /// An anchor at voxel (i, l) with centre p from the expansion e; false when nothing (not even
-  /// the voxel itself) is certified.
-  bool make(const Expansion& e, int i, int l, const Vec3& p, Anchor& a) {
+  /// the voxel itself) is certified. With `shift` > 0 the anchor must reach `shift` columns to
+  /// its left (the first voxel not yet covered lies there: the anchor sits ahead of it, so that
+  /// its rectangle does not overlap the previous one) and spans the whole block, else false.
+  bool make(const Expansion& e, int i, int l, const Vec3& p, Anchor& a, int shift = 0) {
     std::array<Vec3, 3> inv;
     b_ = &loc_.step_bounds(e.piece, e.t);
     if (!b_->valid || !invert(e.jac, inv)) return false;
@@ -165,6 +178,17 @@ public:
         best_up = up, best_down = down, best_k = K, best_kn = both_ways ? K : 0;
       }
     };
+    if (shift > 0) {
+      const int up = l, down = rows_ - 1 - l;
+      const int K = largest([&](int k) { return certified(shift, k, up, down); }, guess_[0]);
+      if (K < 0) return false;
+      guess_[0] = K;
+      for (int r = 0; r < rows_; ++r) {
+        a.lo[static_cast<std::size_t>(r)] = std::max(0, i - shift);
+        a.hi[static_cast<std::size_t>(r)] = std::min(nx_ - 1, i + K);
+      }
+      return true;
+    }
     // The whole block first; the narrower shapes only when it spans few columns.
     consider(0);
     if (best_k < 2) {
@@ -257,19 +281,22 @@ private:
     // certified like any other. Outside the box a polynomial of degree n grows by at most the
     // Chebyshev factor T_n(1 + 2 delta / len) <= cosh(n sqrt(4 delta / len)).
     Vec3 out{};
-    double grow = 1.0, off = 0.0;
+    double off = 0.0;
+    const double dkn = kn, dkp = kp, dln = ln, dlp = lp;
     for (std::size_t j = 0; j < 3; ++j) {
+      // The extreme parameters over the rectangle: at its corners.
       const double base = e_->t[j] + c0_[j];
-      const double c[4] = {base - kn * dx_[j] - ln * dy_[j], base + kp * dx_[j] - ln * dy_[j], base - kn * dx_[j] + lp * dy_[j],
-                           base + kp * dx_[j] + lp * dy_[j]};
-      const double lo = std::min({c[0], c[1], c[2], c[3]}), hi = std::max({c[0], c[1], c[2], c[3]});
+      const double xa = -dkn * dx_[j], xb = dkp * dx_[j], ya = -dln * dy_[j], yb = dlp * dy_[j];
+      const double lo = base + std::min(xa, xb) + std::min(ya, yb), hi = base + std::max(xa, xb) + std::max(ya, yb);
       out[j] = std::max({0.0, hi + r[j] - b_->hi[j], b_->lo[j] - (lo - r[j])});
-      if (out[j] > 0.0) {
-        grow *= std::cosh(b_->degree[j] * std::sqrt(4.0 * out[j] / (b_->hi[j] - b_->lo[j])));
-        off += b_->slope[j] * out[j];
-      }
+      off += b_->slope[j] * out[j];
     }
     if (off > 0.0) {
+      // grow >= 1: too far out whatever the growth factor (and a larger G only reaches farther).
+      if (!(off <= tol_)) return 0;
+      double grow = 1.0;
+      for (std::size_t j = 0; j < 3; ++j)
+        if (out[j] > 0.0) grow *= std::cosh(b_->degree[j] * std::sqrt(4.0 * out[j] / (b_->hi[j] - b_->lo[j])));
       if (!(grow <= G)) return G > 1.0 ? 0 : -1;
       if (!(grow * off <= tol_)) return 0;
     }
@@ -298,6 +325,86 @@ private:
   std::array<Vec3, 3> w_{};     ///< bounds on |J0^-1 d^2X/dt_d dt_e|
   double omega_ = 0.0;
   std::array<int, 3> guess_{-1, -1, -1};
+};
+
+/// A proof that points beyond a face of a cell are not in the leaves of one Bezier piece near
+/// that face, from one expansion at a point tb on the face (where the voxels' linear-model
+/// parameters leave the domain), without Newton. With c = J0^-1 (p - X(tb)) and the piece's
+/// bounds on second partials (StepBounds::b2v, seen through |J0^-1| entrywise: W_j bounds the
+/// j-th component of J0^-1 d^2X / dt_d dt_e summed over d, e), a root t* of X(t) = p at
+/// s = |t* - tb|_inf satisfies s <= |c|_inf + W s^2 / 2 (Taylor along the segment from tb, which
+/// stays where the bounds hold), so s <= s1 = 2 |c| / (1 + sqrt(1 - 2 W |c|)) or s >= s2 =
+/// (1 + sqrt(1 - 2 W |c|)) / W. A leaf of the piece within the bounds' box and closer to tb
+/// than s2 (in every direction) can hold a root only within s1 of tb, and there
+/// t*_j - tb_j >= c_j - W_j s1^2 / 2 (or <= c_j + W_j s1^2 / 2): when that puts t*_j beyond the
+/// domain's face that tb lies on, the leaf holds no root, and p is not in it.
+struct Exclusion {
+  int piece = -1;               ///< -1: unused
+  Vec3 tb{}, xb{};              ///< the expansion point and X(tb)
+  std::array<Vec3, 3> inv{};    ///< J0^-1, rows
+  std::array<int, 3> side{};    ///< +1: tb on the domain's upper face along j; -1 lower; 0 neither
+  Vec3 wj{};                    ///< W_j
+  double w = 0.0;               ///< max_j W_j
+  Vec3 lo{}, hi{};              ///< where the bounds hold
+  double margin = 0.0;          ///< parameter margin beyond the face (rounding)
+
+  /// From an expansion at tb = e.t (t clamped to the domain `dom`, the prediction t beyond it).
+  bool set(const Locator& loc, const Expansion& e, const std::array<Vec3, 2>& dom) {
+    piece = -1;
+    bool any = false;
+    for (std::size_t j = 0; j < 3; ++j) {
+      side[j] = e.t[j] >= dom[1][j] ? 1 : e.t[j] <= dom[0][j] ? -1 : 0;
+      any = any || side[j] != 0;
+    }
+    if (!any || !invert(e.jac, inv)) return false;
+    const StepBounds& b = loc.step_bounds(e.piece);
+    if (!b.valid) return false;
+    w = 0.0;
+    for (std::size_t j = 0; j < 3; ++j) {
+      double sum = 0.0;
+      for (std::size_t d = 0; d < 3; ++d)
+        for (std::size_t f = 0; f < 3; ++f)
+          sum += std::abs(inv[j][0]) * b.b2v[d][f][0] + std::abs(inv[j][1]) * b.b2v[d][f][1] + std::abs(inv[j][2]) * b.b2v[d][f][2];
+      wj[j] = sum * (1.0 + 1e-12);
+      w = std::max(w, wj[j]);
+    }
+    if (!std::isfinite(w)) return false;
+    lo = b.lo;
+    hi = b.hi;
+    margin = 0.0;
+    for (std::size_t j = 0; j < 3; ++j) margin = std::max(margin, 1e-12 * (std::abs(dom[0][j]) + std::abs(dom[1][j])));
+    tb = e.t;
+    xb = e.x;
+    piece = e.piece;
+    return true;
+  }
+
+  /// Whether p lies in none of the leaves [lb, le) that hold voxel i (their row intervals).
+  bool proves(const Vec3& p, int i, const RowLeaf* lb, const RowLeaf* le, std::span<const LocatorLeaf> leaves) const {
+    if (piece < 0) return false;
+    const Vec3 r{p[0] - xb[0], p[1] - xb[1], p[2] - xb[2]};
+    const Vec3 c = mul(inv, r);
+    const double cn = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(c[2])});
+    const double disc = 1.0 - 2.0 * w * cn;
+    if (!(disc > 0.0)) return false;
+    const double sq = std::sqrt(disc);
+    const double s1 = 2.0 * cn / (1.0 + sq);
+    const double s2 = w > 0.0 ? (1.0 + sq) / w : std::numeric_limits<double>::infinity();
+    bool beyond = false;
+    for (std::size_t j = 0; j < 3 && !beyond; ++j) {
+      const double q = 0.5 * wj[j] * s1 * s1 + margin;
+      beyond = (side[j] > 0 && c[j] > q) || (side[j] < 0 && c[j] < -q);
+    }
+    if (!beyond) return false;
+    for (const RowLeaf* rl = lb; rl != le; ++rl) {
+      if (i < rl->i0 || i > rl->i1) continue;
+      const LocatorLeaf& lf = leaves[static_cast<std::size_t>(rl->leaf)];
+      if (lf.piece != piece) return false;
+      for (std::size_t j = 0; j < 3; ++j)
+        if (lf.lo[j] < lo[j] - margin || lf.hi[j] > hi[j] + margin || !(std::max(lf.hi[j] - tb[j], tb[j] - lf.lo[j]) < s2)) return false;
+    }
+    return true;
+  }
 };
 
 /// The last converged voxels of a run in one cell, for extrapolating the next voxel's (u,v,w)
@@ -488,6 +595,7 @@ public:
       const int cell = leaves[static_cast<std::size_t>(cand_[ci])].cell;
       while (ci < cand_.size() && leaves[static_cast<std::size_t>(cand_[ci])].cell == cell) ++ci;
       anchors_.clear();
+      for (auto& x : excl_) x.piece = -1;
       for (int o = 0; o < nr; ++o) walk_row(cell, order[o]);
     }
   }
@@ -558,7 +666,7 @@ private:
         continue;
       }
       ++out_->inverted[ul];
-      visit(cell, l, i, dom, cur, chain, check_run, act.data() + g0, act.data() + next, owner[i], props + static_cast<std::size_t>(i) * um,
+      visit(cell, l, i, span_end, dom, cur, chain, check_run, act.data() + g0, act.data() + next, owner[i], props + static_cast<std::size_t>(i) * um,
             uvw ? uvw + static_cast<std::size_t>(i) * 3 : nullptr);
       ++i;
     }
@@ -566,10 +674,11 @@ private:
 
   /// One voxel off the stepping runs: an anchor at a prediction (its certification covers the
   /// voxel, or its exact residual does), else the slow path (then an anchor at the answer).
+  /// @param span_end   the last voxel of the row's current run of leaf intervals
   /// @param check_run  voxels left to try by a residual check alone (along a boundary, where
   ///                   anchors certify nothing)
-  void visit(int cell, int l, int i, const std::array<Vec3, 2>& dom, int& cur, Chain& chain, int& check_run, RowLeaf* lb,
-             RowLeaf* le, std::int32_t& owner, float* vp, double* vt) {
+  void visit(int cell, int l, int i, int span_end, const std::array<Vec3, 2>& dom, int& cur, Chain& chain, int& check_run,
+             RowLeaf* lb, RowLeaf* le, std::int32_t& owner, float* vp, double* vt) {
     const auto ul = static_cast<std::size_t>(l);
     const Vec3 p = {grid_.origin[0] + (i + 0.5) * grid_.pitch[0], y_[ul], z_};
     auto accept = [&](const Vec3& t) {
@@ -586,10 +695,11 @@ private:
       }
       check_run = 0;
     }
-    // Stepping from a fresh anchor at voxel (i, l).
-    auto anchored = [&]() {
+    // Stepping from a fresh anchor at voxel (i + shift, l), reaching back to voxel i.
+    auto anchored = [&](int shift = 0) {
       Anchor a;
-      if (!maker_->make(exp_, i, l, p, a)) return false;
+      const Vec3 pa = {grid_.origin[0] + (i + shift + 0.5) * grid_.pitch[0], y_[ul], z_};
+      if (!maker_->make(exp_, i + shift, l, shift ? pa : p, a, shift)) return false;
       anchors_.push_back(a);
       cur = static_cast<int>(anchors_.size()) - 1;
       if (!a.covers(l, i)) return false;
@@ -602,8 +712,13 @@ private:
     Vec3 t;
     bool predicted = false, far = false;
     if (cur >= 0) {
-      t = anchors_[static_cast<std::size_t>(cur)].at(l, i);
+      // The next anchor ahead of voxel i by the reach of the last one (an anchor at i itself
+      // would spend half its rectangle on voxels already covered), at the last one's prediction.
+      const Anchor& last = anchors_[static_cast<std::size_t>(cur)];
+      t = last.at(l, i);
       predicted = true;
+      const int shift = std::min(last.hi[ul] - last.ia, span_end - i);
+      if (shift >= 2 && !beyond(t, dom) && loc_.expand(cell, last.at(l, i + shift), exp_) && anchored(shift)) return;
     } else if (chain.n > 0) {
       predicted = chain.predict(dom, t);
     } else if (!anchors_.empty()) {
@@ -619,9 +734,23 @@ private:
       predicted = far = true;
     }
     cur = -1;
+    // Predicted beyond a face of the domain: probably outside, which an exclusion (one of the
+    // last few, or a new one from an expansion at the face) may prove without Newton.
+    bool expanded = false;
+    if (predicted && beyond(t, dom)) {
+      const auto leaves = loc_.leaves();
+      for (const Exclusion& x : excl_)
+        if (x.proves(p, i, lb, le, leaves)) return;
+      if (loc_.expand(cell, t, exp_)) {
+        expanded = !far;
+        Exclusion& x = excl_[excl_next_];
+        excl_next_ = (excl_next_ + 1) % excl_.size();
+        if (x.set(loc_, exp_, dom) && x.proves(p, i, lb, le, leaves)) return;
+      }
+    }
     if (far) {
       // Only a start for Newton: an anchor here would sit off the voxel's preimage.
-    } else if (predicted && loc_.expand(cell, t, exp_)) {
+    } else if (predicted && (expanded || loc_.expand(cell, t, exp_))) {
       if (anchored()) {
         // An anchor certifying little more than its own voxel sits on a boundary (a layer
         // through a face between cells, say): residual checks are cheaper for the next voxels.
@@ -677,6 +806,8 @@ private:
   std::array<std::vector<RowLeaf>, block_rows> act_;
   std::array<std::size_t, block_rows> pos_{};
   std::vector<Anchor> anchors_;
+  std::array<Exclusion, 4> excl_;  ///< the last few made for this cell and block
+  std::size_t excl_next_ = 0;
   std::vector<int> cover_;
   AnchorMaker* maker_ = nullptr;
   Expansion exp_;

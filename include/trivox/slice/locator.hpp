@@ -79,6 +79,12 @@ struct LocatorOptions {
   /// distance (empty space skipped; the sampler uses its largest pitch). 0: only the
   /// relative rule (10% of the leaf's size).
   double leaf_deviation = 0.0;
+  /// When 0 < fine_leaf_deviation < leaf_deviation, a second pass splits the leaves on towards
+  /// this deviation, with at most fine_leaf_factor times the first pass's leaves per piece (the
+  /// most deviating first): tighter regions where they are cheap, without the cost of reaching
+  /// it everywhere in finely refined cells (thousands of small pieces).
+  double fine_leaf_deviation = 0.0;
+  int fine_leaf_factor = 4;
   /// Upper bound on the leaves of one Bezier piece (the most deviating are split first).
   int max_leaves_per_piece = 4096;
 };

@@ -22,7 +22,12 @@
 ///   between cells is certified too), and a bound on |model - P(t*)| below 0.95/512. All bounds
 ///   grow with the distance from the anchor, so an anchor certifies a rectangle of voxels across
 ///   the block's rows at once (found by doubling and bisection on its width); inside it a voxel
-///   costs a few multiply-adds.
+///   costs a few multiply-adds. The next anchor is placed ahead of the first voxel not yet
+///   covered, by the reach of the last one, so that rectangles do not overlap by half.
+/// - A voxel whose predicted parameters leave the cell's domain is first tried for a proof that
+///   it is outside: one expansion at the face and a Taylor bound on where a root could lie,
+///   over the piece's leaves that hold the voxel (without Newton; the proof also serves the next
+///   voxels of the row).
 /// - Elsewhere (near boundaries, rational cells): the voxel is evaluated once at a prediction
 ///   (a new anchor, or an exact residual check |X(t) - p| < tolerance), and failing that Newton
 ///   over the cell domain from the prediction, then the leaves whose intervals hold the voxel
