@@ -237,7 +237,15 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                   {"max_jacobian", q2.det_max},
                   {"cell_volume", q2.cell_volume},
                   {"samples", q2.bd_samples},
-                  {"seconds", q2.seconds}});
+                  {"seconds", q2.seconds},
+                  {"part", c.part}});
+    if (c.part >= 0)
+      jk.back()["seam"] = {{"point", q2.seam_point},
+                           {"gap", q2.seam_gap},
+                           {"angle", q2.seam_angle},
+                           {"glue", q2.seam_glue},
+                           {"glue_before", q2.seam_glue_before},
+                           {"property_jump", q2.seam_property_jump}};
   }
   // Concave corners (seed 000 Sec. 6): the pieces clipped at the rails' crossing and stitched.
   nlohmann::ordered_json js = nlohmann::ordered_json::array();

@@ -12,6 +12,7 @@
 #include "trivox/construct/constructors.hpp"
 #include "trivox/error.hpp"
 #include "trivox/fillet/ruled_fillet.hpp"
+#include "trivox/geom/closest_point.hpp"
 #include "trivox/geom/surface_intersection.hpp"
 #include "trivox/spline/calculus.hpp"
 #include "trivox/spline/extract.hpp"
@@ -535,6 +536,45 @@ Vec eval3(const Surface& s, const Curve& c, double t, Vec* tangent = nullptr) {
   return xyz(d.data());
 }
 
+/// Where B_d (radius d about o) crosses the boundaries of s through o: for every boundary
+/// iso-curve c of s that holds o's parameters o_uv, the root of |c(t) - o| = d on the side of o
+/// where c runs towards `into` (the gap), by regula falsi from o. None where c leaves s first.
+std::vector<std::array<double, 2>> seam_crossings(const Surface& s, const std::array<double, 2>& o_uv, const Vec& o,
+                                                  const Vec& into, double d) {
+  std::vector<std::array<double, 2>> found;
+  const std::array<std::array<double, 2>, 2> dom{s.domain(0), s.domain(1)};
+  const std::size_t k = static_cast<std::size_t>(s.dim());
+  for (std::size_t fix = 0; fix < 2; ++fix)
+    for (const double edge : dom[fix]) {
+      if (std::abs(o_uv[fix] - edge) > 1e-9 * (dom[fix][1] - dom[fix][0])) continue;
+      const std::size_t fr = 1 - fix;
+      const auto uv_at = [&](double t) {
+        std::array<double, 2> uv{};
+        uv[fix] = edge;
+        uv[fr] = t;
+        return uv;
+      };
+      const auto e = s.eval_derivatives({uv_at(o_uv[fr])[0], uv_at(o_uv[fr])[1]}, 1);
+      const double run = dot(xyz(e.data() + (fr == 0 ? k : 2 * k)), into);
+      if (!(std::abs(run) > 0.0)) continue;
+      const double end = run > 0.0 ? dom[fr][1] : dom[fr][0];
+      const auto g = [&](double t) { return norm(sub(point_at(s, uv_at(t)), o)) - d; };
+      double a = o_uv[fr], b = end, ga = g(a), gb = g(b);
+      if (!(gb >= 0.0)) continue;  // the boundary ends inside the sphere
+      for (int it = 0; it < 200 && std::abs(b - a) > 1e-15 * (1.0 + std::abs(a)) && ga != 0.0 && gb != 0.0; ++it) {
+        double m = a - ga * (b - a) / (gb - ga);  // Illinois
+        if (!(m > std::min(a, b) && m < std::max(a, b))) m = 0.5 * (a + b);
+        const double gm = g(m);
+        if (gm == 0.0) a = b = m;
+        else if ((gm < 0.0) == (ga < 0.0)) a = m, ga = gm, gb *= 0.5;
+        else b = m, gb = gm, ga *= 0.5;
+      }
+      const double t = std::abs(ga) <= std::abs(gb) ? a : b;
+      if (dot(sub(point_at(s, uv_at(t)), o), into) > 0.0) found.push_back(uv_at(t));
+    }
+  return found;
+}
+
 std::string piece_name(const FilletPiece& p, const std::vector<SideFace>& s1, const std::vector<SideFace>& s2) {
   return s1[p.face[0]].name + " x " + s2[p.face[1]].name;
 }
@@ -737,9 +777,6 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
     if (!(sa > 0.0 && sb > 0.0))
       throw Error(where + ": the rails' ends p " + at(jn.p) + " and q " + at(jn.q) +
                   " are neither apart nor crossing; expected a convex corner");
-    if (pa.face[gs] != pb.face[gs])
-      throw Error(where + ": the gap lies on two faces (" + (*sides[gs])[pa.face[gs]].name + " and " +
-                  (*sides[gs])[pb.face[gs]].name + "); expected the corner inside one face of the smooth body");
     const double d = fo.distance[gs];
     if (std::abs(norm(sub(jn.p, jn.o)) - d) > jt || std::abs(norm(sub(jn.q, jn.o)) - d) > jt)
       throw Error(where + ": the rails end " + num(norm(sub(jn.p, jn.o))) + " and " + num(norm(sub(jn.q, jn.o))) +
@@ -834,40 +871,102 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
   for (std::size_t jidx = 0; jidx < out.junctions.size(); ++jidx) {
     const Junction& jn = out.junctions[jidx];
     if (jn.kind != JunctionKind::corner) continue;
-    const FilletPiece& pa = out.pieces[jn.piece[0]];
-    const FilletPiece& pb = out.pieces[jn.piece[1]];
-    const auto& ea = pa.ends[static_cast<std::size_t>(jn.end[0])];
-    const auto& eb = pb.ends[static_cast<std::size_t>(jn.end[1])];
+    const std::array<const FilletPiece*, 2> pn{&out.pieces[jn.piece[0]], &out.pieces[jn.piece[1]]};
+    const std::array<const FilletPiece::End*, 2> en{&pn[0]->ends[static_cast<std::size_t>(jn.end[0])],
+                                                    &pn[1]->ends[static_cast<std::size_t>(jn.end[1])]};
     const std::size_t gs = static_cast<std::size_t>(jn.gap_side), hs = 1 - gs;
-    const SideFace& fg = (*sides[gs])[pa.face[gs]];
-    const SideFace& fh = (*sides[hs])[pa.face[hs]];
-    const Surface sg = spline::boundary_face(*fg.cell, fg.face), sh = spline::boundary_face(*fh.cell, fh.face);
-    CornerInput ci;
-    ci.face = &sg;
-    ci.gap_side = jn.gap_side;
-    ci.o_uv = ea.o_uv[gs];
-    ci.p_uv = ea.rail_uv[gs];
-    ci.q_uv = eb.rail_uv[gs];
-    ci.meet = &sh;
-    ci.meet_o_uv = ea.o_uv[hs];
-    ci.meet_r_uv = ea.rail_uv[hs];
-    SubregionOptions so;
-    so.method = fo.method;
-    CornerFillet cf;
-    try {
-      cf = bridge_corner(ci, fo.blend, tol, so);
-    } catch (const Error& e) {
-      throw e.within("fillet corner at " + at(jn.o) + " between " + piece_name(pa, side1, side2) + " and " +
-                     piece_name(pb, side1, side2));
+    const std::string where = "fillet corner at " + at(jn.o) + " between " + piece_name(*pn[0], side1, side2) + " and " +
+                              piece_name(*pn[1], side1, side2);
+    const auto face_of = [&](std::size_t k, std::size_t side) -> const SideFace& { return (*sides[side])[pn[k]->face[side]]; };
+    const auto surface_of = [&](std::size_t k, std::size_t side) {
+      const SideFace& sf = face_of(k, side);
+      return spline::boundary_face(*sf.cell, sf.face);
+    };
+    bool split = pn[0]->face[gs] != pn[1]->face[gs];
+    // The gap on one face: one bridge from p to q. On two (G1-joined along a seam through o):
+    // B_d is split at the seam point s, one bridge per face (p to s, s to q); where s is p or q
+    // (the seam runs along one side of the gap), one bridge on the other face.
+    std::array<Surface, 2> sg{surface_of(0, gs), surface_of(1, gs)};
+    std::array<Surface, 2> sh{surface_of(0, hs), surface_of(1, hs)};
+    std::array<std::array<double, 2>, 2> seam_uv{};
+    // The single bridge's faces and parameters: the arriving piece's, unless s is p.
+    std::size_t on = 0;
+    std::array<std::array<double, 2>, 2> end_uv{en[0]->rail_uv[gs], en[1]->rail_uv[gs]};
+    CornerQuality seam;
+    if (split) {
+      const SideFace &fa = face_of(0, gs), &fb = face_of(1, gs);
+      const double d = 0.5 * (norm(sub(jn.p, jn.o)) + norm(sub(jn.q, jn.o)));
+      const Vec into = unit(axpy(unit(sub(jn.p, jn.o)), 1.0, unit(sub(jn.q, jn.o))));  // towards the gap
+      const geom::SurfaceDistance to_b(sg[1]);
+      bool found = false;
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& uv : seam_crossings(sg[0], en[0]->o_uv[gs], jn.o, into, d)) {
+        const auto cp = to_b.closest(point_at(sg[0], uv));
+        if (cp.distance < best) best = cp.distance, seam_uv = {uv, cp.uv}, found = true;
+      }
+      if (!found)
+        throw Error(where + ": the gap spans " + fa.name + " and " + fb.name + ", but B_d (radius " + num(d) +
+                    ") does not reach a boundary of " + fa.name +
+                    " through the corner; expected two faces joined along a seam through o");
+      seam.seam_point = {point_at(sg[0], seam_uv[0]), point_at(sg[1], seam_uv[1])};
+      seam.seam_gap = best;
+      const Vec x = seam.seam_point[0];
+      if (!(best <= jt))
+        throw Error(where + ": B_d meets the boundary of " + fa.name + " at " + at(x) + ", " + num(best) + " from " +
+                    fb.name + "; expected the two faces joined along a seam through the corner (join tolerance " +
+                    num(jt) + ")");
+      seam.seam_angle = std::acos(std::clamp(std::abs(dot(normal_at(sg[0], seam_uv[0]), normal_at(sg[1], seam_uv[1]))), 0.0, 1.0));
+      if (!(seam.seam_angle <= co.smooth_angle))
+        throw Error(where + ": " + fa.name + " and " + fb.name + " meet at " + at(x) + " at an angle of " +
+                    num(seam.seam_angle) + " rad; expected a G1 seam (at most " + num(co.smooth_angle) + ")");
+      const auto ang = [&](const Vec& a, const Vec& b) {
+        return std::acos(std::clamp(dot(unit(sub(a, jn.o)), unit(sub(b, jn.o))), -1.0, 1.0));
+      };
+      if (!(std::abs(ang(jn.p, x) + ang(x, jn.q) - ang(jn.p, jn.q)) <= 1e-6))
+        throw Error(where + ": the seam point " + at(x) + " of " + fa.name + " and " + fb.name +
+                    " is not between p " + at(jn.p) + " and q " + at(jn.q) + "; expected the seam to cross the gap");
+      if (norm(sub(x, jn.p)) <= jt) {  // B_d runs on the leaving piece's face from p
+        split = false, on = 1;
+        end_uv[0] = seam_uv[1];
+      } else if (norm(sub(x, jn.q)) <= jt) {  // on the arriving piece's face to q
+        split = false;
+        end_uv[1] = seam_uv[0];
+      }
     }
-    cf.junction = jidx;
+    const std::size_t nparts = split ? 2 : 1;
+    std::array<CornerFillet, 2> parts;
+    for (std::size_t k = 0; k < nparts; ++k) {
+      CornerInput ci;
+      const std::size_t f = split ? k : on;  // 0: the arriving piece's faces, 1: the leaving one's
+      ci.face = &sg[f];
+      ci.gap_side = jn.gap_side;
+      ci.o_uv = en[f]->o_uv[gs];
+      ci.p_uv = !split ? end_uv[0] : k == 0 ? en[0]->rail_uv[gs] : seam_uv[1];
+      ci.q_uv = !split ? end_uv[1] : k == 0 ? seam_uv[0] : en[1]->rail_uv[gs];
+      ci.meet = &sh[f];
+      ci.meet_o_uv = en[f]->o_uv[hs];
+      ci.meet_r_uv = en[f]->rail_uv[hs];
+      SubregionOptions so;
+      so.method = fo.method;
+      try {
+        parts[k] = bridge_corner(ci, fo.blend, tol, so);
+      } catch (const Error& e) {
+        throw e.within(where + (split ? " (on " + face_of(k, gs).name + ")" : std::string()));
+      }
+      parts[k].junction = jidx;
+      parts[k].part = split ? static_cast<int>(k) : -1;
+      exact_singular_rows(parts[k].cells, gs);
+    }
     // C0 glue (Sec. 6.1: the bridge meets its neighbours along their end sections): the
     // bridge's end faces against the neighbours' end faces at the same (v, w), cell for cell
     // (both are ruled halves: v from the rail to C, w from S^_i to S_b); the pair of ends (u0 or
     // u1 of each) that fits best is the junction. Measured, then pinned (pin_end) and measured
-    // again: glue_before is what the bridge's own fit and section left, glue what remains.
-    std::array<spline::Face, 2> taken{spline::Face::v0, spline::Face::v0};
+    // again: glue_before is what the bridge's own fit and section left, glue what remains. Split
+    // at a seam, part 0 glues to the arriving piece, part 1 to the leaving one.
+    std::array<const Fillet*, 2> glued_f{};
+    std::array<std::array<spline::Face, 2>, 2> glued_n{};  // per side: the neighbour's end, the bridge's
     for (std::size_t side = 0; side < 2; ++side) {
+      CornerFillet& cf = parts[split ? side : 0];
       FilletPiece& nb = out.pieces[jn.piece[side]];
       double best = std::numeric_limits<double>::infinity();
       Fillet* best_f = nullptr;
@@ -876,7 +975,7 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
       for (Fillet& fl : nb.fillets)
         for (spline::Face fn : {spline::Face::u0, spline::Face::u1})
           for (spline::Face fb : {spline::Face::u0, spline::Face::u1}) {
-            if (fb == taken[0]) continue;  // the other end of the bridge is the other neighbour's
+            if (!split && side == 1 && fb == cf.ends[0]) continue;  // the other end is the other neighbour's
             const auto g0 = face_gaps(spline::boundary_face(cf.cells[0], fb), spline::boundary_face(fl.cells.at(0), fn));
             const auto g1 = face_gaps(spline::boundary_face(cf.cells[1], fb), spline::boundary_face(fl.cells.at(1), fn));
             const double g = std::max(g0[0], g1[0]);
@@ -889,21 +988,47 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
                         " from the neighbour " + piece_name(nb, side1, side2) + "'s; expected at most the join tolerance " +
                         num(jt),
                     ErrorKind::failed);
-      taken[side] = best_b;
       cf.ends[side] = best_b;
-      if (side == 0) exact_singular_rows(cf.cells, gs);
+      if (split) cf.ends[1 - side] = best_b == spline::Face::u0 ? spline::Face::u1 : spline::Face::u0;  // at s
       pin_end(cf.cells, static_cast<int>(gs), best_b, best_f->cells, best_n);
+      glued_f[side] = best_f;
+      glued_n[side] = {best_n, best_b};
+    }
+    if (split) {
+      // The seam: part 1's end at s pinned onto part 0's (a copy, as for the stitches: part 0's
+      // layers stay as they are); no singular rows to carry, both hold o and r exactly.
+      const spline::Face e0 = parts[0].ends[1], e1 = parts[1].ends[0];
+      for (std::size_t c = 0; c < 2; ++c)
+        seam.seam_glue_before = std::max(seam.seam_glue_before, face_gaps(spline::boundary_face(parts[1].cells[c], e1),
+                                                                          spline::boundary_face(parts[0].cells[c], e0))[0]);
+      if (!(seam.seam_glue_before <= jt))
+        throw Error(where + ": the bridge's two parts' sections at the seam point " + at(seam.seam_point[0]) + " lie " +
+                        num(seam.seam_glue_before) + " apart; expected at most the join tolerance " + num(jt),
+                    ErrorKind::failed);
+      std::array<Trivariate, 2> first = parts[0].cells;
+      pin_end(parts[1].cells, -1, e1, first, e0);
+      for (std::size_t c = 0; c < 2; ++c) {
+        const auto g = face_gaps(spline::boundary_face(parts[1].cells[c], e1), spline::boundary_face(parts[0].cells[c], e0));
+        seam.seam_glue = std::max(seam.seam_glue, g[0]);
+        seam.seam_property_jump = std::max(seam.seam_property_jump, g[1]);
+      }
+    }
+    // The glue once every pin is made, and the rail's ends: the neighbours' rail ends p and q
+    // (and s, where split).
+    for (std::size_t side = 0; side < 2; ++side) {
+      CornerFillet& cf = parts[split ? side : 0];
       std::array<double, 2> after{};
       for (std::size_t c = 0; c < 2; ++c) {
-        const auto g = face_gaps(spline::boundary_face(cf.cells[c], best_b), spline::boundary_face(best_f->cells.at(c), best_n));
+        const auto g = face_gaps(spline::boundary_face(cf.cells[c], glued_n[side][1]),
+                                 spline::boundary_face(glued_f[side]->cells.at(c), glued_n[side][0]));
         after = {std::max(after[0], g[0]), std::max(after[1], g[1])};
       }
       cf.quality.glue[side] = after[0];
       cf.quality.property_jump[side] = after[1];
     }
-    measure_cells(cf);
-    // The rail's ends after pinning: the neighbours' rail ends, p and q.
-    {
+    for (std::size_t k = 0; k < nparts; ++k) {
+      CornerFillet& cf = parts[k];
+      measure_cells(cf);
       // The half on S_g: its face v = 0 (half 0) or v = 1 (half 1) collapses onto the rail.
       const Trivariate& h = cf.cells[gs];
       const auto du = h.domain(0), dv = h.domain(1), dw = h.domain(2);
@@ -911,12 +1036,25 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
       double e = 0.0;
       for (std::size_t side = 0; side < 2; ++side) {
         const double u = du[cf.ends[side] == spline::Face::u0 ? 0 : 1];
-        const Vec want = side == 0 ? jn.p : jn.q;
+        const Vec want = !split ? (side == 0 ? jn.p : jn.q) : (k == side ? (side == 0 ? jn.p : jn.q) : seam.seam_point[0]);
         e = std::max(e, norm(sub(xyz(h.eval({u, v, dw[0]})), want)));
       }
       cf.quality.end_error = std::max(cf.quality.end_error, e);
+      if (split) {
+        cf.quality.seam_point = seam.seam_point;
+        cf.quality.seam_gap = seam.seam_gap;
+        cf.quality.seam_angle = seam.seam_angle;
+        cf.quality.seam_glue = seam.seam_glue;
+        cf.quality.seam_glue_before = seam.seam_glue_before;
+        cf.quality.seam_property_jump = seam.seam_property_jump;
+        const std::size_t at_s = 1 - k;  // the part's side glued to the other part
+        cf.quality.glue_before[at_s] = seam.seam_glue_before;
+        cf.quality.glue[at_s] = seam.seam_glue;
+        cf.quality.property_jump[at_s] = seam.seam_property_jump;
+        cf.quality.property_jump_before[at_s] = 0.0;
+      }
+      out.corners.push_back(std::move(cf));
     }
-    out.corners.push_back(std::move(cf));
   }
   return out;
 }

@@ -498,7 +498,10 @@ std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOpe
     rep.cell_names = {base + "a", base + "b"};
     rep.pieces = {piece_name(mf.pieces[jn.piece[0]]), piece_name(mf.pieces[jn.piece[1]])};
     const std::size_t g = static_cast<std::size_t>(jn.gap_side);
-    rep.faces = {sides[g][mf.pieces[jn.piece[0]].face[g]].name, sides[1 - g][mf.pieces[jn.piece[0]].face[1 - g]].name};
+    // A bridge split at a seam (part 1: from the seam to q) lies on the leaving piece's faces.
+    const fillet::FilletPiece& on = mf.pieces[jn.piece[cf.part == 1 ? 1 : 0]];
+    rep.faces = {sides[g][on.face[g]].name, sides[1 - g][on.face[1 - g]].name};
+    rep.part = cf.part;
     rep.junction = jn;
     rep.quality = cf.quality;
     if (cf.quality.jacobian() == "changes sign")

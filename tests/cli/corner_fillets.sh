@@ -14,6 +14,8 @@
 #   the cylinder; p and q are 2 from o on the cylinder, r = o +- (0, 2, 0) on the edge; det J > 0
 #   inside; the bridges are pinned to their neighbours' end sections: glue at rounding level,
 #   no property jump, and `trivox validate` finds no cell invalid;
+# - the turned column through a plate of two cells (below): B_d across the plate's seam, the
+#   bridges there in two parts (Fig. 12 (d));
 # - the concave corner of an L-shaped prism on a plate (models/l_notch.json, below): stitched;
 # - bad input exits 2 naming the place: a concave corner whose rails cross beyond the pieces,
 #   faces that do not meet, "corners" without face lists, the flend section or
@@ -77,6 +79,68 @@ column_scene "$tmp/open.json" ', "corners": "open"'
 cell=$(loc "$tmp/open.model.json" 1.1414,1.1414,0.1)
 [ "$cell" = - ] || { echo "open corners: the gap point is in '$cell'"; exit 1; }
 "$py" -c 'import sys, json; r = json.load(open(sys.argv[1])); assert r["corners"] == [] and len(r["fillets"]) == 4' "$tmp/open.build.json"
+
+# Fig. 12 (d): B_d across a seam. The column turned 45 degrees about z (an explicit trilinear
+# cell: edges at (+-sqrt 2, 0) and (0, +-sqrt 2)) through a plate of two box cells joined along
+# x = 0: at the corners (0, +-sqrt 2, 0) p and q lie on the two cells and B_d crosses the seam at
+# s = (0, +-(sqrt 2 + 1), 0); the bridge there is built in two parts, one per plate cell, an eighth
+# turn each (Pappus), glued to each other at rounding level; the corners (+-sqrt 2, 0, 0) are
+# inside one cell (a quarter turn). The whole ring's bridges: four quarter turns, as unturned.
+"$py" - "$tmp/seam.json" <<'PY'
+import sys, json, math
+c = math.sqrt(0.5)
+pts = [[c * (x - y), c * (x + y), z, 0, 0, 1] for z in (-1, 3) for y in (-1, 1) for x in (-1, 1)]
+kv = [0, 0, 1, 1]
+json.dump({"trivox": 1, "units": "mm", "properties": ["r", "g", "b"],
+  "cells": [
+    {"name": "west", "primitive": {"type": "box", "min": [-4, -4, -2], "max": [0, 4, 0]}, "field": {"constant": [1, 0, 0]}},
+    {"name": "east", "primitive": {"type": "box", "min": [0, -4, -2], "max": [4, 4, 0]}, "field": {"constant": [1, 0, 0]}},
+    {"name": "column", "trivariate": {"orders": [2, 2, 2], "knots": [kv, kv, kv], "points": pts}}],
+  "operations": [{"op": "fillet", "name": "ring",
+    "between": [[{"cell": "west", "face": "w1"}, {"cell": "east", "face": "w1"}],
+                [{"cell": "column", "face": f} for f in ("u0", "v0", "u1", "v1")]],
+    "distance": [1.0, 0.5], "tau": 1.0}]}, open(sys.argv[1], "w"))
+PY
+"$trivox" build "$tmp/seam.json" -o "$tmp/seam.model.json" --json > "$tmp/seam.build.json"
+"$py" - "$tmp/seam.build.json" <<'PY'
+import sys, json, math
+sys.path.insert(0, "tests/cli")
+from fillet_math import hermite_area, hermite_moment
+r = json.load(open(sys.argv[1]))
+assert r["valid"], "every cell valid"
+d1, d2, tau = 1.0, 0.5, 1.0
+quarter = math.pi / 2 * hermite_moment(d1, d2, tau)
+k = r["corners"]
+assert len(r["fillets"]) == 4 and len(k) == 6, (len(r["fillets"]), len(k))
+parts = 0
+for c in k:
+    o = c["o"]
+    v = sum(c["cell_volume"])
+    assert c["jacobian"] == "positive" and c["min_jacobian"] > 0, c
+    assert max(c["glue"]) < 1e-12 and max(c["property_jump"]) < 1e-12, (c["glue"], c["property_jump"])
+    if abs(o[0]) > 1e-9:
+        assert c["part"] == -1 and abs(v - quarter) < 1e-5 * quarter, (o, c["part"], v, quarter)
+        continue
+    parts += 1
+    assert c["part"] in (0, 1) and abs(v - quarter / 2) < 1e-5 * quarter, (o, c["part"], v, quarter / 2)
+    assert c["gap_face"] in ("west/w1", "east/w1"), c["gap_face"]
+    s = c["seam"]
+    want = [0, o[1] + math.copysign(d1, o[1]), 0]
+    assert all(math.dist(x, want) < 1e-9 for x in s["point"]), (s["point"], want)
+    assert s["glue"] < 1e-12 and s["glue_before"] < 1e-5 and s["gap"] < 1e-9 and s["angle"] < 1e-12, s
+    print(f"seam corner {o[1]:+.4f}, part {c['part']} on {c['gap_face']}: volume {v:.9f} (Pappus/2 {quarter / 2:.9f}), "
+          f"seam glue {s['glue']:.1e} (before {s['glue_before']:.1e})")
+assert parts == 4, parts
+vol = {x["name"]: x["volume"] for x in r["cells"]}
+bridges = sum(v for n, v in vol.items() if n.startswith("ring.c"))
+assert abs(bridges - 4 * quarter) < 1e-5 * 4 * quarter, (bridges, 4 * quarter)
+print(f"seam ring: bridges {bridges:.9f} (4 quarter turns {4 * quarter:.9f})")
+PY
+# Bad input: the east cell ends at y = 2.2, past p but before the seam point (0, sqrt 2 + 1, 0).
+"$py" -c 'import sys, json; m = json.load(open(sys.argv[1])); m["cells"][1]["primitive"]["max"] = [4, 2.2, 0]; json.dump(m, open(sys.argv[2], "w"))' \
+  "$tmp/seam.json" "$tmp/bad.json"
+expect_fail '/operations/0: fillet corner at (.*/w1 x column.*/w1 x column.*seam through' \
+  "$trivox" build "$tmp/bad.json" -o "$tmp/bad.model.json"
 
 # Fig. 12: the box and the cylinder.
 "$trivox" build models/box_cylinder.json -o "$tmp/bc.model.json" --json > "$tmp/bc.build.json"

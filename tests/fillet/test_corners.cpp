@@ -253,3 +253,127 @@ TEST_CASE("fillet across faces: bad input names the place", "[fillet][corners]")
     CHECK_THROWS_WITH(fillet::fillet_across(c.side1, c.side2, o), Catch::Contains("Hermite section"));
   }
 }
+
+namespace {
+
+/// The column turned 45 degrees about z (its vertical edges at (+-sqrt 2, 0) and (0, +-sqrt 2)),
+/// through a plate made of two cells joined along the seam x = 0 (planar, so G1): the corners
+/// (0, +-sqrt 2) lie on the seam, and their gaps, from p = o + d1 (+-1, 1) / sqrt 2 (or the
+/// mirror) to q, span both plate cells; the corners (+-sqrt 2, 0) lie inside one.
+struct SeamColumn {
+  static spline::Trivariate turned(spline::Trivariate h) {
+    const double c = std::sqrt(0.5);
+    for (int i = 0; i < h.count(0) * h.count(1) * h.count(2); ++i) {
+      double* x = h.point(i).data();
+      const double a = x[0], b = x[1];
+      x[0] = c * (a - b);
+      x[1] = c * (a + b);
+    }
+    return h;
+  }
+  spline::Trivariate west = box_cell({-4, -4, -2}, {0, 4, 0}, 1.0);
+  spline::Trivariate east = box_cell({0, -4, -2}, {4, 4, 0}, 1.0);
+  spline::Trivariate column = turned(box_cell({-1, -1, -1}, {1, 1, 3}, 2.0));
+  std::vector<fillet::SideFace> side1{{&west, spline::Face::w1, "west/w1"}, {&east, spline::Face::w1, "east/w1"}};
+  std::vector<fillet::SideFace> side2{{&column, spline::Face::u0, "column/u0"},
+                                      {&column, spline::Face::v1, "column/v1"},
+                                      {&column, spline::Face::u1, "column/u1"},
+                                      {&column, spline::Face::v0, "column/v0"}};
+};
+
+}  // namespace
+
+TEST_CASE("fillet across faces: a convex corner on a seam of the smooth body, B_d across two faces (Fig. 12 (d))",
+          "[fillet][corners]") {
+  SeamColumn c;
+  fillet::FilletOptions o;
+  const double d1 = 1.0, d2 = 0.5, tau = 1.0;
+  o.distance = {d1, d2};
+  o.blend.tau = tau;
+  const auto m = fillet::fillet_across(c.side1, c.side2, o);
+  REQUIRE(m.pieces.size() == 4);
+  CHECK(m.closed);
+  REQUIRE(m.junctions.size() == 4);
+  // Two corners inside one plate cell (one bridge each), two on the seam (two parts each).
+  REQUIRE(m.corners.size() == 6);
+  const double area = hermite_area(d1, d2, tau);
+  const double quarter = std::numbers::pi / 2 * hermite_moment(d1, d2, tau);  // Pappus, a quarter turn
+  const double tol = 1e-7 * std::sqrt(8 * 8 + 8 * 8 + 5 * 5);
+  for (const auto& p : m.pieces) {
+    REQUIRE(p.fillets.size() == 1);
+    double v = 0.0;
+    for (double x : p.fillets[0].quality.cell_volume) v += x;
+    CHECK(v == Approx(2.0 * area).epsilon(1e-9));  // the section along a face of length 2
+  }
+  std::vector<double> per_junction(m.junctions.size(), 0.0);
+  int split = 0;
+  for (const auto& cf : m.corners) {
+    const auto& q = cf.quality;
+    const auto& j = m.junctions[cf.junction];
+    INFO("corner at " << j.o[0] << ", " << j.o[1] << ", part " << cf.part);
+    CHECK(j.kind == fillet::JunctionKind::corner);
+    CHECK(j.gap_side == 0);
+    CHECK(q.jacobian() == "positive");
+    CHECK(q.det_min > 0.0);
+    CHECK(q.end_error < 1e-9);
+    CHECK(q.o_error < 1e-9);
+    CHECK(q.r_error < 1e-9);
+    CHECK(q.radius_error < tol);
+    CHECK(q.g1_angle < 1e-5);
+    CHECK(q.glue[0] < 1e-12);  // to the neighbour or, split, to the other part
+    CHECK(q.glue[1] < 1e-12);
+    CHECK(q.glue_before[0] < 10 * tol);
+    CHECK(q.glue_before[1] < 10 * tol);
+    CHECK(q.property_jump[0] < 1e-12);
+    CHECK(q.property_jump[1] < 1e-12);
+    CHECK(cf.ends[0] != cf.ends[1]);
+    const double v = q.cell_volume[0] + q.cell_volume[1];
+    per_junction[cf.junction] += v;
+    const bool on_seam = std::abs(j.o[0]) < 1e-9;
+    CHECK(on_seam == (cf.part >= 0));
+    if (cf.part < 0) {
+      CHECK(v == Approx(quarter).epsilon(1e-5));
+      continue;
+    }
+    ++split;
+    // Each part an eighth turn about the edge (the seam bisects the right angle between p and q).
+    CHECK(v == Approx(quarter / 2).epsilon(1e-5));
+    // The seam point s = o + d1 (0, +-1, 0), the same on both plate cells; the faces are G1 there.
+    const double sy = j.o[1] + std::copysign(d1, j.o[1]);
+    for (const auto& s : q.seam_point) CHECK(std::hypot(s[0], s[1] - sy, s[2]) < 1e-9);
+    CHECK(q.seam_gap < 1e-9);
+    CHECK(q.seam_angle < 1e-12);
+    CHECK(q.seam_glue < 1e-12);
+    CHECK(q.seam_glue_before < 10 * tol);
+    CHECK(q.seam_property_jump < 1e-12);
+    // Part 0 on the arriving piece's plate cell, part 1 on the leaving one's: the rail's end at
+    // s on the seam, and g_1 = 1 on the plate's sub-region, g_2 = 2 on the column's.
+    const auto& h = cf.cells[0];
+    const auto du = h.domain(0);
+    const double us = du[cf.ends[cf.part == 0 ? 1 : 0] == spline::Face::u0 ? 0 : 1];
+    const auto s = h.eval({us, 0.0, 0.0});
+    CHECK(std::hypot(s[0], s[1] - sy, s[2]) < 1e-9);
+    CHECK(h.eval({0.3, 0.4, 0.0})[3] == Approx(1.0).epsilon(1e-12));
+    CHECK(cf.cells[1].eval({0.3, 0.4, 0.0})[3] == Approx(2.0).epsilon(1e-12));
+  }
+  CHECK(split == 4);
+  // Every corner, split or not, is the quarter turn of the unturned column's test.
+  for (double v : per_junction) CHECK(v == Approx(quarter).epsilon(1e-5));
+}
+
+TEST_CASE("fillet across faces: a gap over two faces that do not join at a seam names the place", "[fillet][corners]") {
+  SeamColumn c;
+  // The east plate cell ends at y = 2.2: it still holds its pieces' rails (p at y = sqrt 2 +
+  // 1 / sqrt 2 < 2.2), but not the seam point s = (0, sqrt 2 + 1, 0) of the corner (0, sqrt 2).
+  c.east = box_cell({0, -4, -2}, {4, 2.2, 0}, 1.0);
+  fillet::FilletOptions o;
+  o.distance = {1.0, 0.5};
+  try {
+    (void)fillet::fillet_across(c.side1, c.side2, o);
+    FAIL("no error");
+  } catch (const Error& e) {
+    CHECK(e.kind() == trivox::ErrorKind::bad_input);
+    CHECK_THAT(e.what(), Catch::Contains("fillet corner at (") && Catch::Contains("1.41421") && Catch::Contains("west/w1") &&
+                             Catch::Contains("east/w1") && Catch::Contains("seam through"));
+  }
+}

@@ -14,7 +14,8 @@
 /// - one side's rails meet (its body has an edge through o, perpendicular to the other body's
 ///   face there, so both its rails end on that edge at the same point r) and the other side's
 ///   leave a gap between p (the last point of one piece's rail) and q (the first of the next):
-///   a convex corner, bridged as below (Sec. 6.1); with the tangents t_a (arriving at o) and t_b
+///   a convex corner, bridged as below (Sec. 6.1; p and q may lie on two faces
+///   of the smooth body joined G1 at o); with the tangents t_a (arriving at o) and t_b
 ///   (leaving o) of C, convex means (q - p) . t_a > 0 and (q - p) . t_b > 0 (Fig. 12 (b)-(c));
 /// - the gap side's rails cross instead ((q - p) . t_a < 0 and (q - p) . t_b < 0): a concave
 ///   corner, clipped and stitched (below; on two faces of the smooth body: Error (bad_input));
@@ -64,6 +65,26 @@
 ///   control points becomes the neighbour's. The end faces are then one function, xyz and
 ///   properties: glue and property jump at rounding level (CornerQuality::glue, property_jump;
 ///   glue_before, property_jump_before: what pinning removed).
+/// - B_d across a seam (Fig. 12 (d): p and q on two faces S_{1,2}, S_{1,3} of the smooth body,
+///   joined G1). The gap's two ends lie on the arriving and the leaving piece's faces S_a, S_b;
+///   then B_d crosses their shared boundary. The seam point s: on each boundary iso-curve c(t)
+///   of S_a through o's parameters, the root of |c(t) - o| = d (d the mean of |p - o|, |q - o|)
+///   on the side of o towards the gap (c'(t_o) . (p^ + q^) > 0; regula falsi from o); of those,
+///   the one nearest S_b (closest point: s on S_b, their distance CornerQuality::seam_gap, within
+///   the join tolerance, and the normals' angle seam_angle, within smooth_angle: else Error
+///   (bad_input) naming both faces), and s must lie between p and q (the angles about o add
+///   up). The bridge is then built per face, as two bridges of the construction above: part 0
+///   from p to s on S_a, part 1 from s to q on S_b, each with its own fan to o on its face, the
+///   edge segment o r, and the Hermite section, which at s is the same on both faces (it
+///   depends only on s, o, r, the normal there and tau: G1 faces have one normal). So B_d, the
+///   fan, G1 along B_d and det J > 0 inside hold part by part, exactly as for one face; part
+///   0's end at p is pinned to the arriving piece, part 1's at q to the leaving one, and part 1's
+///   end at s onto part 0's (as a stitch: no singular rows to carry, both hold o and r
+///   exactly): seam_glue at rounding level (seam_glue_before: the two parts' own fits). Each
+///   part's properties come from its own face, so a seam that is C0 in properties gives a
+///   bridge C0 in properties (seam_property_jump). A fan across the seam (one cell for both
+///   faces) would need a composition with a piecewise S_g, or a fit of both faces; one bridge
+///   per face keeps every existing guarantee and the exact pinning.
 ///
 /// Step 1b (Sec. 6, Fig. 12 (b)), the stitch at a concave corner. The text: "concave
 /// discontinuities could be similarly handled ... while it would result with C1 discontinuities
@@ -88,8 +109,9 @@
 /// det J vanishes on the fan's edge at o and on the segment face (singular by construction, as
 /// on the rails of every ruled fillet) and is checked at interior samples.
 ///
-/// Cost: per pair one fillet_faces; per convex corner a few hundred surface evaluations for B_d,
-/// one composition or fit, one interpolation per halving and one ruling; the report samples a
+/// Cost: per pair one fillet_faces; per convex corner (per face of it) a few hundred surface
+/// evaluations for B_d, one composition or fit, one interpolation per halving and one ruling (and
+/// one closest-point set-up on the second face at a seam); the report samples a
 /// few thousand points and closest points to the neighbours' end faces.
 #pragma once
 #include <array>
@@ -177,6 +199,13 @@ struct CornerQuality {
   /// Property jump across the glued ends: max |g_bridge - g_neighbour| (coordinates 3..k-1) on
   /// the end faces at the same (v, w), after and before pinning (0 without properties)
   std::array<double, 2> property_jump{}, property_jump_before{};
+  /// A corner whose gap spans two faces of the smooth body (part >= 0, see CornerFillet): the
+  /// seam point s = B_d n seam on the first face and on the second (xyz), their distance, the
+  /// angle between the faces' normals there, and the C0 glue between the two parts' sections at
+  /// s after pinning (xyz; properties) and before (the parts' own fits)
+  std::array<std::array<double, 3>, 2> seam_point{};
+  double seam_gap = 0.0, seam_angle = 0.0;
+  double seam_glue = 0.0, seam_glue_before = 0.0, seam_property_jump = 0.0;
   std::array<int, 2> bd_samples{};  ///< samples of B_d; Greville rows of the section
   double seconds = 0.0;
   /// "positive", "negative" or "changes sign".
@@ -191,6 +220,10 @@ struct CornerFillet {
   /// fillet_across: the cells' faces (u0 or u1) glued to the arriving piece (ends[0]) and to the
   /// leaving one (ends[1])
   std::array<spline::Face, 2> ends{spline::Face::u0, spline::Face::u1};
+  /// -1: the whole bridge (the gap inside one face). 0, 1: the gap spans two faces, split at
+  /// the seam point s: part 0 from p to s on the arriving piece's face (ends[1]: its end at s),
+  /// part 1 from s to q on the leaving piece's (ends[0]: its end at s, pinned onto part 0's)
+  int part = -1;
   CornerQuality quality;
 };
 
@@ -214,7 +247,9 @@ CornerFillet bridge_corner(const CornerInput& input, const BlendOptions& blend, 
 struct MultiFillet {
   std::vector<FilletPiece> pieces;  ///< in order along C
   std::vector<Junction> junctions;  ///< in order along C; the last joins the last piece to the first when closed
-  std::vector<CornerFillet> corners;  ///< one per convex corner (CornerOptions::bridge)
+  /// one per convex corner (CornerOptions::bridge); two (parts 0 and 1, adjacent) where the gap
+  /// spans a seam between two faces
+  std::vector<CornerFillet> corners;
   bool closed = false;              ///< the pieces form one closed loop
 };
 

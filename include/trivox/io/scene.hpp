@@ -212,6 +212,9 @@ struct CornerBuild {
   std::array<std::string, 2> cell_names;  ///< <name>.c<j>a, <name>.c<j>b
   std::array<std::string, 2> pieces;      ///< the neighbouring pieces, "cell/face x cell/face"
   std::array<std::string, 2> faces;       ///< the face with the gap (smooth at o), the one with the edge
+  /// -1: the whole bridge; 0, 1: its part on the arriving or the leaving piece's face (the gap
+  /// spans a seam, fillet::CornerFillet::part)
+  int part = -1;
   fillet::Junction junction;
   fillet::CornerQuality quality;
 };
