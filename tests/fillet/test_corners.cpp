@@ -30,6 +30,14 @@ double hermite_moment(double d1, double d2, double tau) {
   return fillet_test::hermite_integral(d1, d2, tau, [](double X, double, double, double dZ) { return 0.5 * X * X * dZ; });
 }
 
+/// Fillet options with the rails' distances d1, d2 on the two sides and the blend's tau.
+fillet::FilletOptions options(double d1, double d2, double tau) {
+  fillet::FilletOptions o;
+  o.distance = {d1, d2};
+  o.blend.tau = tau;
+  return o;
+}
+
 double dist(const std::array<double, 3>& a, const std::vector<double>& b) {
   return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
 }
@@ -48,10 +56,8 @@ struct Column {
 
 TEST_CASE("fillet across a column's faces: Sec. 6 pieces and Sec. 6.1 bridges at the convex corners", "[fillet][corners]") {
   Column c;
-  fillet::FilletOptions o;
   const double d1 = 1.0, d2 = 0.5, tau = 1.0;
-  o.distance = {d1, d2};
-  o.blend.tau = tau;
+  const fillet::FilletOptions o = options(d1, d2, tau);
   const auto m = fillet::fillet_across(c.side1, c.side2, o);
   REQUIRE(m.pieces.size() == 4);
   CHECK(m.closed);
@@ -149,10 +155,8 @@ struct Notch {
 
 TEST_CASE("fillet across faces: a concave corner, rails clipped and stitched (Sec. 6, Fig. 12 (b))", "[fillet][corners]") {
   Notch c;
-  fillet::FilletOptions o;
   const double d1 = 0.5, d2 = 0.25, tau = 1.0;
-  o.distance = {d1, d2};
-  o.blend.tau = tau;
+  const fillet::FilletOptions o = options(d1, d2, tau);
   const auto m = fillet::fillet_across(c.side1, c.side2, o);
   REQUIRE(m.pieces.size() == 2);
   CHECK_FALSE(m.closed);
@@ -286,10 +290,8 @@ struct SeamColumn {
 TEST_CASE("fillet across faces: a convex corner on a seam of the smooth body, B_d across two faces (Fig. 12 (d))",
           "[fillet][corners]") {
   SeamColumn c;
-  fillet::FilletOptions o;
   const double d1 = 1.0, d2 = 0.5, tau = 1.0;
-  o.distance = {d1, d2};
-  o.blend.tau = tau;
+  const fillet::FilletOptions o = options(d1, d2, tau);
   const auto m = fillet::fillet_across(c.side1, c.side2, o);
   REQUIRE(m.pieces.size() == 4);
   CHECK(m.closed);
