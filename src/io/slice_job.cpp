@@ -270,10 +270,15 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
   std::size_t next = 0;
 
+  // A layer's pixels into its PNG and the PNG's digest.
+  auto encode = [&](LayerOut& out, const std::uint8_t* pixels) {
+    out.png = encode_png_rgba(pixels, nx, ny, cfg.dpi_x, cfg.dpi_y);
+    out.sha256 = sha256_hex(out.png);
+  };
+
   auto sample_layer = [&](int k) {
     LayerOut out;
     out.layer = k;
-    out.counts.assign(static_cast<std::size_t>(nmat), 0);
     Scratch& s = scratch.local();
     s.rgba.resize(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny) * 4);
     std::vector<std::int64_t> counts(static_cast<std::size_t>(nmat), 0);
@@ -296,9 +301,8 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       }
       lap(t, s.seconds[2]);
     }
-    out.counts = counts;
-    out.png = encode_png_rgba(s.rgba.data(), nx, ny, cfg.dpi_x, cfg.dpi_y);
-    out.sha256 = sha256_hex(out.png);
+    out.counts = std::move(counts);
+    encode(out, s.rgba.data());
     lap(t, s.seconds[4]);
     return out;
   };
@@ -352,9 +356,8 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       lap(t, s.seconds[2]);
     }
     for (std::size_t i = 0; i < un; ++i) {
-      outs[i].counts = counts[i];
-      outs[i].png = encode_png_rgba(s.rgbas[i].data(), nx, ny, cfg.dpi_x, cfg.dpi_y);
-      outs[i].sha256 = sha256_hex(outs[i].png);
+      outs[i].counts = std::move(counts[i]);
+      encode(outs[i], s.rgbas[i].data());
     }
     lap(t, s.seconds[4]);
     return outs;
@@ -363,10 +366,10 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   tbb::parallel_pipeline(
       static_cast<std::size_t>(tokens),
       tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                                      [&](tbb::flow_control& fc) -> std::size_t {
-                                                        if (next >= groups.size()) fc.stop();
-                                                        return next++;
-                                                      }) &
+                                          [&](tbb::flow_control& fc) -> std::size_t {
+                                            if (next >= groups.size()) fc.stop();
+                                            return next++;
+                                          }) &
           tbb::make_filter<std::size_t, std::vector<LayerOut>>(
               tbb::filter_mode::parallel, [&](std::size_t g) { return sample_group(groups[g]); }) &
           tbb::make_filter<std::vector<LayerOut>, void>(tbb::filter_mode::serial_in_order, [&](std::vector<LayerOut> outs) {

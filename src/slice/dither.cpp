@@ -549,8 +549,8 @@ struct GroupRow {
     _mm256_storeu_ps(o, r0), _mm256_storeu_ps(o + 8, r1), _mm256_storeu_ps(o + 16, r2), _mm256_storeu_ps(o + 24, r3);
     _mm256_storeu_ps(o + 32, r4), _mm256_storeu_ps(o + 40, r5), _mm256_storeu_ps(o + 48, r6), _mm256_storeu_ps(o + 56, r7);
   }
-  for (; j < n; ++j)
-    for (int l = 0; l < 8; ++l) d[j * 8 + static_cast<std::size_t>(l)] = s[l][j];
+  for (; j < n; ++j)  // as bytes: the elements may be int32 (cells)
+    for (int l = 0; l < 8; ++l) std::memcpy(d + j * 8 + static_cast<std::size_t>(l), s[l] + j, 4);
 }
 
 /// dst[l][j] = src[j * 8 + l] for j < n and l < lanes: the inverse of to_lanes.
@@ -559,15 +559,13 @@ struct GroupRow {
   float* d[8];
   for (int l = 0; l < 8; ++l) d[l] = static_cast<float*>(dst[l]);
   std::size_t j = 0;
-  if (lanes == 8)
-    for (; j + 8 <= n; j += 8) {
-      const float* q = s + j * 8;
-      __m256 r0 = _mm256_loadu_ps(q), r1 = _mm256_loadu_ps(q + 8), r2 = _mm256_loadu_ps(q + 16), r3 = _mm256_loadu_ps(q + 24),
-             r4 = _mm256_loadu_ps(q + 32), r5 = _mm256_loadu_ps(q + 40), r6 = _mm256_loadu_ps(q + 48), r7 = _mm256_loadu_ps(q + 56);
-      transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
-      _mm256_storeu_ps(d[0] + j, r0), _mm256_storeu_ps(d[1] + j, r1), _mm256_storeu_ps(d[2] + j, r2), _mm256_storeu_ps(d[3] + j, r3);
-      _mm256_storeu_ps(d[4] + j, r4), _mm256_storeu_ps(d[5] + j, r5), _mm256_storeu_ps(d[6] + j, r6), _mm256_storeu_ps(d[7] + j, r7);
-    }
+  for (; j + 8 <= n; j += 8) {
+    const float* q = s + j * 8;
+    __m256 r[8];
+    for (int l = 0; l < 8; ++l) r[l] = _mm256_loadu_ps(q + 8 * l);
+    transpose8(r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]);
+    for (int l = 0; l < lanes; ++l) _mm256_storeu_ps(d[l] + j, r[l]);
+  }
   for (; j < n; ++j)
     for (int l = 0; l < lanes; ++l) std::memcpy(d[l] + j, s + j * 8 + static_cast<std::size_t>(l), 4);
 }
@@ -578,11 +576,11 @@ struct GroupRow {
 /// for the same lane, and cmykw_fractions' for the fractions (max and min equal its compares on
 /// the clamped, NaN-free values; the clamps keep its NaN -> 0); the carry w0 (v - hit) equals
 /// fs_kernel8's select between w0 v and w0 (v - 1) (v - 0 is v). So each layer's choices equal
-/// the single-layer kernel's. (Computing the carry for both outcomes before the choice, as
-/// fs_kernel8 does to shorten its chain, measured no faster here: eight layers per step make the
-/// loop bound by its instructions and registers, not its chain.) The only difference: a void lane's error is +0 where the
-/// single-layer kernel skips it, which can turn a -0 into +0, and a zero's sign never
-/// reaches a comparison or a nonzero sum.
+/// the single-layer kernel's. The only difference: a void lane's error is +0 where the
+/// single-layer kernel skips it, which can turn a -0 into +0, and a zero's sign never reaches a
+/// comparison or a nonzero sum. (Computing the carry for both outcomes before the choice, as
+/// fs_kernel8 does to shorten its chain, measured no faster here: with eight layers per step the
+/// loop is bound by its vector instructions, not by its chain.)
 [[gnu::target("avx2"), gnu::always_inline]] inline void group_kernel(const GroupRow& a) {
   constexpr int K = group_k, S = group_stride;
   const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
