@@ -161,28 +161,13 @@ Curve trace_bd(const Surface& s, const Frame& f, const CornerInput& in, double t
               ErrorKind::failed);
 }
 
-/// det J at interior samples of a cell: per u sample 6 x 4 across.
-std::array<double, 2> det_range(const Trivariate& h) {
-  std::array<double, 2> r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-  const auto du = h.domain(0), dv = h.domain(1), dw = h.domain(2);
-  for (int a = 0; a < 24; ++a)
-    for (int b = 0; b < 6; ++b)
-      for (int c = 0; c < 4; ++c) {
-        const double det = jacobian_at(h, {du[0] + (du[1] - du[0]) * (a + 0.5) / 24,
-                                           dv[0] + (dv[1] - dv[0]) * (b + 0.5) / 6, dw[0] + (dw[1] - dw[0]) * (c + 0.5) / 4});
-        r[0] = std::min(r[0], det);
-        r[1] = std::max(r[1], det);
-      }
-  return r;
-}
-
 /// The bridge's cells: sampled det J and volumes.
 void measure_cells(CornerFillet& cf) {
   CornerQuality& qa = cf.quality;
   qa.det_min = std::numeric_limits<double>::infinity();
   qa.det_max = -qa.det_min;
   for (std::size_t c = 0; c < 2; ++c) {
-    const auto rg = det_range(cf.cells[c]);
+    const auto rg = sampled_jacobian(cf.cells[c]);
     qa.cell_jacobian[c] = rg;
     qa.det_min = std::min(qa.det_min, rg[0]);
     qa.det_max = std::max(qa.det_max, rg[1]);
@@ -504,15 +489,7 @@ void remeasure(Fillet& fl) {
   q.det_min = std::numeric_limits<double>::infinity();
   q.det_max = -q.det_min;
   for (const Trivariate& h : fl.cells) {
-    std::array<double, 2> r{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-    const auto dv = h.domain(1), dw = h.domain(2);
-    for (const double u : u_samples(h))
-      for (int b = 0; b < 6; ++b)
-        for (int c = 0; c < 4; ++c) {
-          const double det = jacobian_at(h, {u, dv[0] + (dv[1] - dv[0]) * (b + 0.5) / 6, dw[0] + (dw[1] - dw[0]) * (c + 0.5) / 4});
-          r[0] = std::min(r[0], det);
-          r[1] = std::max(r[1], det);
-        }
+    const std::array<double, 2> r = sampled_jacobian(h);
     q.cell_jacobian.push_back(r);
     q.cell_volume.push_back(std::abs(boundary_volume(h)));
     q.det_min = std::min(q.det_min, r[0]);

@@ -226,16 +226,7 @@ void measure(const std::array<const Surface*, 2>& faces, const Surface& blend, c
   q.det_max = -q.det_min;
   const int n1 = 6, n2 = q.construction == Construction::ruled ? 4 : 6;
   for (const Trivariate& h : f.cells) {
-    std::array<double, 2> range{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-    const auto dv = h.domain(1), dw = h.domain(2);
-    for (const double u : u_samples(h))
-      for (int b = 0; b < n1; ++b)
-        for (int c = 0; c < n2; ++c) {
-          const double det = jacobian_at(h, {u, dv[0] + (dv[1] - dv[0]) * (b + 0.5) / n1,
-                                             dw[0] + (dw[1] - dw[0]) * (c + 0.5) / n2});
-          range[0] = std::min(range[0], det);
-          range[1] = std::max(range[1], det);
-        }
+    const std::array<double, 2> range = sampled_jacobian(h, n1, n2);
     q.cell_jacobian.push_back(range);
     // vrep: the trimmed cell, T_hbs less the solid beyond S_b (inside it: VrepReport::outside).
     q.cell_volume.push_back(q.construction == Construction::vrep

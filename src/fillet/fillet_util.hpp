@@ -4,6 +4,7 @@
 #pragma once
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <span>
@@ -204,6 +205,22 @@ inline std::vector<double> u_samples(const spline::Trivariate& t) {
     for (int a = 0; a < 16; ++a) out.push_back(d[0] + (d[1] - d[0]) * (a + 0.5) / 16);
   }
   return out;
+}
+
+/// det J sampled inside a cell (not bounded: fillet cells' det J vanishes on their rails, seed 000
+/// Sec. 9, where geom::check_validity chases it): at u_samples along u times n1 x n2 midpoints
+/// across. Returns {min, max}.
+inline std::array<double, 2> sampled_jacobian(const spline::Trivariate& h, int n1 = 6, int n2 = 4) {
+  std::array<double, 2> range{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  const auto dv = h.domain(1), dw = h.domain(2);
+  for (const double u : u_samples(h))
+    for (int b = 0; b < n1; ++b)
+      for (int c = 0; c < n2; ++c) {
+        const double det = jacobian_at(h, {u, dv[0] + (dv[1] - dv[0]) * (b + 0.5) / n1, dw[0] + (dw[1] - dw[0]) * (c + 0.5) / n2});
+        range[0] = std::min(range[0], det);
+        range[1] = std::max(range[1], det);
+      }
+  return range;
 }
 
 /// The signed volume int det J of a polynomial cell by the divergence theorem: det DX =

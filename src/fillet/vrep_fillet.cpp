@@ -59,21 +59,6 @@ double invert(const Trivariate& t, const Vec& p, std::array<double, 3> uvw) {
   return detail::norm(detail::sub(detail::xyz(d.data()), p));
 }
 
-/// Sampled det J of a cell: per knot span along u its midpoint, times 6 x 4 points across.
-std::array<double, 2> sampled_jacobian(const Trivariate& h) {
-  std::array<double, 2> range{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
-  const auto dv = h.domain(1), dw = h.domain(2);
-  for (const double u : detail::u_samples(h))
-    for (int b = 0; b < 6; ++b)
-      for (int c = 0; c < 4; ++c) {
-        const double det =
-            detail::jacobian_at(h, {u, dv[0] + (dv[1] - dv[0]) * (b + 0.5) / 6, dw[0] + (dw[1] - dw[0]) * (c + 0.5) / 4});
-        range[0] = std::min(range[0], det);
-        range[1] = std::max(range[1], det);
-      }
-  return range;
-}
-
 /// Alg. 6 lines 8-11: the trimming curve C_Sb of the cap T_hbs(e, v, w), the curve where the
 /// solid beyond S_b meets it, in the cap's (v, w): S_b's end section projected on the cap (65
 /// samples, warm-started Newton from rail 1 at (v, w) = (1, 0)), interpolated by a cubic.
@@ -182,7 +167,7 @@ VrepFillet vrep_fillet(const Surface& sub1, const Surface& sub2, const Surface& 
   VrepFillet out;
   out.beyond = {construct::ruled(ba, F1), construct::ruled(bb, F2)};
   for (std::size_t i = 0; i < 2; ++i) {
-    rep.beyond_jacobian[i] = sampled_jacobian(out.beyond[i]);
+    rep.beyond_jacobian[i] = detail::sampled_jacobian(out.beyond[i]);
     const auto& r = rep.beyond_jacobian[i];
     if (!((r[0] > 0.0 && r[1] > 0.0) || (r[0] < 0.0 && r[1] < 0.0)))
       throw Error("V-rep fillet: det J of the solid beyond S_b (part " + std::to_string(i + 1) + ") ranges over [" +
