@@ -38,18 +38,6 @@ namespace {
 
 std::string at(const Vec& p) { return "(" + num(p[0]) + ", " + num(p[1]) + ", " + num(p[2]) + ")"; }
 
-Vec unit(const Vec& a) {
-  const double n = norm(a);
-  return n > 0.0 ? scale(a, 1.0 / n) : a;
-}
-
-/// Unit normal of s (xyz) at uv; zero where s is singular.
-Vec normal_at(const Surface& s, const std::array<double, 2>& uv) {
-  const auto d = s.eval_derivatives({uv[0], uv[1]}, 1);
-  const std::size_t k = static_cast<std::size_t>(s.dim());
-  return unit(cross(xyz(d.data() + k), xyz(d.data() + 2 * k)));
-}
-
 Vec point_at(const Surface& s, const std::array<double, 2>& uv) { return xyz(s.eval({uv[0], uv[1]})); }
 
 /// A constant curve at uv in the space `knots` (R^2).
@@ -191,7 +179,7 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
   const int g = in.gap_side;
   Frame f;
   f.o = point_at(s, in.o_uv);
-  f.n = normal_at(s, in.o_uv);
+  f.n = unit_normal(s, in.o_uv[0], in.o_uv[1]);
   const Vec p = point_at(s, in.p_uv), q = point_at(s, in.q_uv);
   f.dp = norm(sub(p, f.o));
   f.dq = norm(sub(q, f.o));
@@ -223,7 +211,7 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
   const auto section = [&](double phi, Vec& q1, Vec& q2) {
     const Vec b = xyz(rail.eval({phi}));
     const auto uv = bd.eval({phi});
-    const Vec n = normal_at(s, {uv[0], uv[1]});
+    const Vec n = unit_normal(s, uv[0], uv[1]);
     const Vec toward = sub(f.o, b);
     const Vec tg = unit(axpy(toward, -dot(toward, n), n));  // towards o in S_g's tangent plane
     const double len = blend.tau * norm(sub(b, r)) / 3.0;
@@ -294,7 +282,7 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
     const auto d = sb.eval_derivatives({phi, vb}, 1);
     const Vec nb = cross(xyz(d.data() + 3), xyz(d.data() + 6));
     if (norm(nb) > 1e-12 * std::max(1.0, norm(xyz(d.data() + 3)) * norm(xyz(d.data() + 6)))) {
-      const double cs = std::abs(dot(unit(nb), normal_at(s, {uv[0], uv[1]})));
+      const double cs = std::abs(dot(unit(nb), unit_normal(s, uv[0], uv[1])));
       qa.g1_angle = std::max(qa.g1_angle, std::acos(std::min(1.0, cs)));
     }
   }
@@ -892,7 +880,7 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
         throw Error(where + ": B_d meets the boundary of " + fa.name + " at " + at(x) + ", " + num(best) + " from " +
                     fb.name + "; expected the two faces joined along a seam through the corner (join tolerance " +
                     num(jt) + ")");
-      seam.seam_angle = std::acos(std::clamp(std::abs(dot(normal_at(sg[0], seam_uv[0]), normal_at(sg[1], seam_uv[1]))), 0.0, 1.0));
+      seam.seam_angle = std::acos(std::clamp(std::abs(dot(unit_normal(sg[0], seam_uv[0][0], seam_uv[0][1]), unit_normal(sg[1], seam_uv[1][0], seam_uv[1][1]))), 0.0, 1.0));
       if (!(seam.seam_angle <= co.smooth_angle))
         throw Error(where + ": " + fa.name + " and " + fb.name + " meet at " + at(x) + " at an angle of " +
                     num(seam.seam_angle) + " rad; expected a G1 seam (at most " + num(co.smooth_angle) + ")");

@@ -62,18 +62,6 @@ SplineShape shape(const spline::TensorSpline<P>& s) {
   return out;
 }
 
-/// Unit normal of s at (u, v); zero where s is singular.
-Vec unit_normal(const Surface& s, double u, double v, Vec* across = nullptr) {
-  const auto d = s.eval_derivatives({u, v}, 1);
-  const std::size_t k = static_cast<std::size_t>(s.dim());
-  Vec n = cross(xyz(d.data() + k), xyz(d.data() + 2 * k));
-  if (across) *across = {d[2 * k], d[2 * k + 1], d[2 * k + 2]};
-  const double len = norm(n);
-  if (len > 0.0)
-    for (double& x : n) x /= len;
-  return n;
-}
-
 double diagonal(const Trivariate& a, const Trivariate& b) {
   const auto ba = spline::bounding_box(a, 3), bb = spline::bounding_box(b, 3);
   double s = 0.0;

@@ -4,9 +4,9 @@
 #pragma once
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -41,6 +41,18 @@ inline double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
 /// The first three values (xyz) of a point.
 inline Vec xyz(const double* p) { return {p[0], p[1], p[2]}; }
 inline Vec xyz(const std::vector<double>& p) { return {p[0], p[1], p[2]}; }
+/// a / |a| (a itself when it is zero).
+inline Vec unit(const Vec& a) {
+  const double n = norm(a);
+  return n > 0.0 ? Vec{a[0] / n, a[1] / n, a[2] / n} : a;
+}
+/// Unit normal of s (xyz) at (u, v); zero where s is singular. `across`: dS/dv there.
+inline Vec unit_normal(const spline::Surface& s, double u, double v, Vec* across = nullptr) {
+  const auto d = s.eval_derivatives({u, v}, 1);
+  const std::size_t k = static_cast<std::size_t>(s.dim());
+  if (across) *across = xyz(d.data() + 2 * k);
+  return unit(cross(xyz(d.data() + k), xyz(d.data() + 2 * k)));
+}
 
 /// The same knots with every non-empty span split at its middle (simple new knots).
 inline spline::KnotVector halved(const spline::KnotVector& k) {
