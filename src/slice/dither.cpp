@@ -599,8 +599,9 @@ struct GroupRow {
   const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
   __m256 acc_here[K], acc_fwd[K], carry[K];
   for (int k = 0; k < K; ++k) acc_here[k] = acc_fwd[k] = carry[k] = zero;
-  // The counts in memory (L1): registers are short (the loop's state is 15 vectors).
-  alignas(32) float cnt[K][8] = {};
+  // The counts: per material and lane, minus the sum of its hit masks (each hit is -1 as int32).
+  __m256i cnt[K];
+  for (int k = 0; k < K; ++k) cnt[k] = _mm256_setzero_si256();
   // The weights of the first, middle and last columns (the forward neighbour's per lane).
   const __m256* first_with = a.weights[nx > 1 ? has_forward | has_down_forward : 0];
   const __m256* first_without = a.weights[nx > 1 ? has_down_forward : 0];
@@ -668,7 +669,7 @@ struct GroupRow {
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_permutevar8x32_epi32(table, idx));
     for (int k = 0; k < K; ++k) {
       const __m256 h = _mm256_and_ps(hit[k], one);
-      _mm256_store_ps(cnt[k], _mm256_add_ps(_mm256_load_ps(cnt[k]), h));
+      cnt[k] = _mm256_sub_epi32(cnt[k], _mm256_castps_si256(hit[k]));
       const __m256 err = _mm256_and_ps(live, _mm256_sub_ps(v[k], h));  // +0 in void lanes
       carry[k] = _mm256_mul_ps(w[0], err);
       _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
@@ -679,7 +680,7 @@ struct GroupRow {
   for (int k = 0; k < K; ++k) {
     _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x - dir) * S + 8 * k, acc_here[k]);
     _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x) * S + 8 * k, acc_fwd[k]);
-    a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_load_ps(cnt[k]));
+    a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_cvtepi32_ps(cnt[k]));
   }
 }
 
