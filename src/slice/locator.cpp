@@ -58,16 +58,17 @@ inline void bernstein(int order, double s, double* B, double* dB) {
 /// Geometry kernel: the first H coordinates of every control point (points `nc` coordinates
 /// apart) contracted with the Bernstein basis: f = the value (H numbers) and, when D, the partials
 /// in the piece's local parameters (3 x H more). Contracts u, then v, then w, so the partials cost
-/// O(o^3 H) together. O: uniform order known at compile time (0: read from ord).
-template <int O, int H, bool D, int NS = 0>
+/// O(o^3 H) together. OU, OV, OW: the orders known at compile time (0: read from ord); the same
+/// operations in the same order either way, so every instantiation gives the same floats.
+template <int OU, int OV, int OW, int H, bool D, int NS = 0>
 void geom_kernel(const double* net, int stride, const std::array<int, 3>& ord, const double* s, double* f) {
-  constexpr int M = O ? O : max_order;
+  constexpr int MU = OU ? OU : max_order, MV = OV ? OV : max_order, MW = OW ? OW : max_order;
   const int nc = NS ? NS : stride;  // coordinates per control point (compile-time when NS > 0)
-  const int ou = O ? O : ord[0], ov = O ? O : ord[1], ow = O ? O : ord[2];
-  double Bu[M], Bv[M], Bw[M], dBu[D ? M : 1], dBv[D ? M : 1], dBw[D ? M : 1];
-  bernstein<O>(ou, s[0], Bu, D ? dBu : nullptr);
-  bernstein<O>(ov, s[1], Bv, D ? dBv : nullptr);
-  bernstein<O>(ow, s[2], Bw, D ? dBw : nullptr);
+  const int ou = OU ? OU : ord[0], ov = OV ? OV : ord[1], ow = OW ? OW : ord[2];
+  double Bu[MU], Bv[MV], Bw[MW], dBu[D ? MU : 1], dBv[D ? MV : 1], dBw[D ? MW : 1];
+  bernstein<OU>(ou, s[0], Bu, D ? dBu : nullptr);
+  bernstein<OV>(ov, s[1], Bv, D ? dBv : nullptr);
+  bernstein<OW>(ow, s[2], Bw, D ? dBw : nullptr);
   double S[H] = {}, Su[H] = {}, Sv[H] = {}, Sw[H] = {};
   for (int c = 0; c < ow; ++c) {
     double T[H] = {}, Tu[H] = {}, Tv[H] = {};
@@ -109,15 +110,15 @@ void geom_kernel(const double* net, int stride, const std::array<int, 3>& ord, c
 /// Value kernel: all nc coordinates of the net at s (geometry and properties in one pass),
 /// contracted u, then v, then w, so the sums form short independent chains (instruction-level
 /// parallelism) rather than one chain of order^3 terms per coordinate.
-/// NC: coordinates known at compile time (0: nc, in chunks).
-template <int O, int NC>
+/// NC: coordinates known at compile time (0: nc, in chunks). OU, OV, OW as geom_kernel's.
+template <int OU, int OV, int OW, int NC>
 void value_kernel(const double* net, int nc, const std::array<int, 3>& ord, const double* s, double* f) {
-  constexpr int M = O ? O : max_order;
-  const int ou = O ? O : ord[0], ov = O ? O : ord[1], ow = O ? O : ord[2];
-  double Bu[M], Bv[M], Bw[M];
-  bernstein<O>(ou, s[0], Bu, nullptr);
-  bernstein<O>(ov, s[1], Bv, nullptr);
-  bernstein<O>(ow, s[2], Bw, nullptr);
+  constexpr int MU = OU ? OU : max_order, MV = OV ? OV : max_order, MW = OW ? OW : max_order;
+  const int ou = OU ? OU : ord[0], ov = OV ? OV : ord[1], ow = OW ? OW : ord[2];
+  double Bu[MU], Bv[MV], Bw[MW];
+  bernstein<OU>(ou, s[0], Bu, nullptr);
+  bernstein<OV>(ov, s[1], Bv, nullptr);
+  bernstein<OW>(ow, s[2], Bw, nullptr);
   constexpr int chunk = NC ? NC : 16;
   const int n = NC ? NC : nc;  // NC, when given, equals nc: a compile-time stride
   for (int h0 = 0; h0 < n; h0 += chunk) {
@@ -139,7 +140,7 @@ void value_kernel(const double* net, int nc, const std::array<int, 3>& ord, cons
 }
 
 /// Every coordinate with its first partials for order 4 in all directions (polynomial, NC
-/// coordinates per point; the layout of geom_kernel<4, NC, true, NC>): contracted w first, over
+/// coordinates per point; the layout of geom_kernel<4, 4, 4, NC, true, NC>): contracted w first, over
 /// whole contiguous slabs of the net (4 x 4 points), then v over rows, then u, so that the bulk
 /// of the work is long loops of independent multiply-adds that vectorise. The same operations
 /// in the same order per coordinate whatever the vector width: the AVX2 and the baseline
@@ -214,27 +215,31 @@ struct Kernels {
   Kernel all_first = nullptr;  ///< every coordinate with first partials (polynomial, nc <= 10)
 };
 
-template <int O, int H>
+template <int OU, int OV, int OW, int H>
 Kernels kernels_for(int nc) {
-  Kernels k{geom_kernel<O, H, true>, geom_kernel<O, H, false>, value_kernel<O, 0>, nullptr};
+  constexpr bool o4 = OU == 4 && OV == 4 && OW == 4;
+  Kernels k{geom_kernel<OU, OV, OW, H, true>, geom_kernel<OU, OV, OW, H, false>, value_kernel<OU, OV, OW, 0>, nullptr};
   [&]<int... I>(std::integer_sequence<int, I...>) {
-    (((nc == I + 3) ? (k.all = value_kernel<O, I + 3>,
-                       k.all_first = H != 3 ? nullptr : O == 4 ? first_o4_kernel<I + 3>() : geom_kernel<O, I + 3, true, I + 3>, 0)
+    (((nc == I + 3) ? (k.all = value_kernel<OU, OV, OW, I + 3>,
+                       k.all_first = H != 3 ? nullptr : o4 ? first_o4_kernel<I + 3>() : geom_kernel<OU, OV, OW, I + 3, true, I + 3>, 0)
                     : 0),
      ...);
   }(std::make_integer_sequence<int, 8>{});
   return k;
 }
 
+/// Kernels with the orders fixed at compile time for the common pieces: uniform orders 2 to 4,
+/// and the shells and tubes the scenes build (cubic faces swept linearly, (4, 4, 2); linear
+/// sections swept along a cubic, (2, 2, 4)); any other orders read them at run time.
 template <int H>
 Kernels pick_kernels(const std::array<int, 3>& ord, int nc) {
-  if (ord[0] == ord[1] && ord[1] == ord[2]) switch (ord[0]) {
-      case 2: return kernels_for<2, H>(nc);
-      case 3: return kernels_for<3, H>(nc);
-      case 4: return kernels_for<4, H>(nc);
-      default: break;
-    }
-  return kernels_for<0, H>(nc);
+  const auto is = [&](int a, int b, int c) { return ord[0] == a && ord[1] == b && ord[2] == c; };
+  if (is(2, 2, 2)) return kernels_for<2, 2, 2, H>(nc);
+  if (is(3, 3, 3)) return kernels_for<3, 3, 3, H>(nc);
+  if (is(4, 4, 4)) return kernels_for<4, 4, 4, H>(nc);
+  if (is(4, 4, 2)) return kernels_for<4, 4, 2, H>(nc);
+  if (is(2, 2, 4)) return kernels_for<2, 2, 4, H>(nc);
+  return kernels_for<0, 0, 0, H>(nc);
 }
 
 // ---------------------------------------------------------------------------------------------
