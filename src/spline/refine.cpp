@@ -13,11 +13,11 @@ namespace {
 
 using detail::Net;
 
-/// A one-dimensional change of representation: the new knot vector and the matrix taking old
-/// control points to new ones.
+/// A one-dimensional change of representation: the new knot vector and the (banded) matrix
+/// taking old control points to new ones.
 struct Map1D {
   KnotVector to;
-  Eigen::MatrixXd T;
+  detail::Banded T;
 };
 
 std::string num(double v) {
@@ -26,34 +26,51 @@ std::string num(double v) {
   return buf;
 }
 
-Map1D identity_map(const KnotVector& kv) {
-  return {kv, Eigen::MatrixXd::Identity(kv.size(), kv.size())};
-}
+Map1D identity_map(const KnotVector& kv) { return {kv, detail::Banded::identity(kv.size())}; }
 
-/// Inserts `add` (sorted or not) into the map's target, composing the matrix. The matrix is
-/// kept banded while knots go in (a row of a refinement map has at most `order` non-zeros per
-/// original row's band), so each insertion costs O(n * order), not O(n * columns): thousands of
-/// spans (Bezier extraction of a fine revolution) stay fast. Each new row is Boehm's convex
-/// combination, the same arithmetic as on dense rows.
+/// Inserts `add` (sorted or not) into the map's target, composing the matrix, which stays banded
+/// (a row of a refinement map has at most `order` non-zeros per original row's band): each new
+/// row is Boehm's convex combination (NURBS Book A5.1). The knots go in in increasing order, so
+/// the rows and knots are held as gap buffers split where the next knot goes (the rows before
+/// it never change again, those after it only shift): O(n + k order) for k knots into n rows,
+/// where inserting into flat vectors moved every later row and knot at each insertion.
 Map1D insert_into(Map1D m, std::vector<double> add) {
   std::sort(add.begin(), add.end());
-  std::vector<double> knots = m.to.knots();
   const int order = m.to.order();
   const int p = order - 1;
   struct Row {
     int first = 0;
     std::vector<double> c;  // T(i, first + k) = c[k]
   };
-  const int cols = static_cast<int>(m.T.cols());
-  std::vector<Row> rows(static_cast<std::size_t>(m.T.rows()));
-  for (int i = 0; i < static_cast<int>(m.T.rows()); ++i) {
-    int a = 0, b = cols - 1;
-    while (a < cols && m.T(i, a) == 0.0) ++a;
-    while (b > a && m.T(i, b) == 0.0) --b;
-    Row& r = rows[static_cast<std::size_t>(i)];
-    r.first = a < cols ? a : 0;
-    for (int k = a; k <= b && a < cols; ++k) r.c.push_back(m.T(i, k));
+  const detail::Banded& B = m.T;
+  const int cols = B.cols;
+  // Before the split: left (in order); after it: right, reversed (right.back() comes next).
+  std::vector<Row> left, right;
+  left.reserve(static_cast<std::size_t>(B.rows()) + add.size());
+  right.reserve(static_cast<std::size_t>(B.rows()));
+  for (int j = B.rows() - 1; j >= 0; --j) {
+    const auto uj = static_cast<std::size_t>(j);
+    right.push_back({B.first[uj], std::vector<double>(B.vals.begin() + static_cast<std::ptrdiff_t>(B.start[uj]),
+                                                      B.vals.begin() + static_cast<std::ptrdiff_t>(B.start[uj + 1]))});
   }
+  std::vector<double> kleft, kright(m.to.knots().rbegin(), m.to.knots().rend());
+  kleft.reserve(kright.size() + add.size());
+  const auto row = [&](int i) -> const Row& {
+    const auto ui = static_cast<std::size_t>(i);
+    return ui < left.size() ? left[ui] : right[right.size() - 1 - (ui - left.size())];
+  };
+  const auto knot = [&](int i) {
+    const auto ui = static_cast<std::size_t>(i);
+    return ui < kleft.size() ? kleft[ui] : kright[kright.size() - 1 - (ui - kleft.size())];
+  };
+  const auto split_rows = [&](std::size_t at) {
+    for (; left.size() < at; right.pop_back()) left.push_back(std::move(right.back()));
+    for (; left.size() > at; left.pop_back()) right.push_back(std::move(left.back()));
+  };
+  const auto split_knots = [&](std::size_t at) {
+    for (; kleft.size() < at; kright.pop_back()) kleft.push_back(kright.back());
+    for (; kleft.size() > at; kleft.pop_back()) kright.push_back(kleft.back());
+  };
   const auto combine = [](const Row& x, double ax, const Row& y, double ay) {
     Row out;
     if (x.c.empty() && y.c.empty()) return out;
@@ -70,34 +87,49 @@ Map1D insert_into(Map1D m, std::vector<double> add) {
     }
     return out;
   };
+  std::vector<Row> fresh;
   for (double t : add) {
     if (!(t >= m.to.front() && t <= m.to.back()))
       throw Error("knot " + num(t) + " outside the domain [" + num(m.to.front()) + ", " + num(m.to.back()) +
                   "]; expected a value inside it");
-    const auto mult = std::count(knots.begin(), knots.end(), t);
+    // The knots <= t before the split; t's multiplicity is the run of equal knots just before it.
+    while (!kright.empty() && kright.back() <= t) split_knots(kleft.size() + 1);
+    const int u = static_cast<int>(kleft.size());
+    int mult = 0;
+    while (mult < u && kleft[static_cast<std::size_t>(u - 1 - mult)] == t) ++mult;
     if (mult >= order)
       throw Error("knot " + num(t) + " already has multiplicity " + std::to_string(mult) +
                   "; expected at most the order (" + std::to_string(order) + ")");
     // The span t_mu <= t < t_mu+1 (at the right end: the last non-empty span), as KnotVector::find_span.
-    const int n = static_cast<int>(knots.size()) - order;
-    int mu = static_cast<int>(std::upper_bound(knots.begin(), knots.end(), t) - knots.begin()) - 1;
-    mu = std::clamp(mu, p, n - 1);
-    while (mu > p && knots[static_cast<std::size_t>(mu)] == knots[static_cast<std::size_t>(mu + 1)]) --mu;
-    // Boehm (NURBS Book A5.1): rows mu-p+1..mu become convex combinations, the rest shift.
-    std::vector<Row> fresh;
-    for (int i = mu - p + 1; i <= mu; ++i) {
-      const double ti = knots[static_cast<std::size_t>(i)];
-      const double a = (t - ti) / (knots[static_cast<std::size_t>(i + p)] - ti);
-      fresh.push_back(combine(rows[static_cast<std::size_t>(i)], a, rows[static_cast<std::size_t>(i - 1)], 1.0 - a));
+    const int n = static_cast<int>(kleft.size() + kright.size()) - order;
+    int mu = std::clamp(u - 1, p, n - 1);
+    while (mu > p && knot(mu) == knot(mu + 1)) --mu;
+    split_rows(static_cast<std::size_t>(mu) + 1);  // rows 0..mu before the split
+    if (p == 0) {  // order 1: the basis function of span mu splits in two with the same coefficient
+      right.push_back(left.back());
+    } else {
+      // Rows mu-p+1..mu become convex combinations; the old row mu moves to mu+1.
+      fresh.clear();
+      for (int i = mu - p + 1; i <= mu; ++i) {
+        const double ti = knot(i);
+        const double a = (t - ti) / (knot(i + p) - ti);
+        fresh.push_back(combine(row(i), a, row(i - 1), 1.0 - a));
+      }
+      Row last = std::move(left.back());
+      left.resize(static_cast<std::size_t>(mu - p + 1));
+      for (Row& r : fresh) left.push_back(std::move(r));
+      right.push_back(std::move(last));
     }
-    rows.erase(rows.begin() + (mu - p + 1), rows.begin() + mu);
-    rows.insert(rows.begin() + (mu - p + 1), std::make_move_iterator(fresh.begin()), std::make_move_iterator(fresh.end()));
-    knots.insert(knots.begin() + mu + 1, t);
+    split_knots(static_cast<std::size_t>(mu) + 1);
+    kleft.push_back(t);
   }
-  m.T = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), cols);
-  for (std::size_t i = 0; i < rows.size(); ++i)
-    for (std::size_t k = 0; k < rows[i].c.size(); ++k) m.T(static_cast<Eigen::Index>(i), rows[i].first + static_cast<Eigen::Index>(k)) = rows[i].c[k];
-  m.to = KnotVector(order, std::move(knots));
+  detail::Banded T;
+  T.cols = cols;
+  split_rows(left.size() + right.size());
+  for (const Row& r : left) T.push_row(r.first, r.c.data(), r.c.size());
+  split_knots(kleft.size() + kright.size());
+  m.T = std::move(T);
+  m.to = KnotVector(order, std::move(kleft));
   return m;
 }
 
@@ -105,7 +137,7 @@ Map1D insert_into(Map1D m, std::vector<double> add) {
 Map1D select(Map1D m, int first, int count) {
   const int order = m.to.order();
   std::vector<double> knots(m.to.knots().begin() + first, m.to.knots().begin() + first + count + order);
-  m.T = m.T.middleRows(first, count).eval();
+  m.T = m.T.middle_rows(first, count);
   m.to = KnotVector(order, std::move(knots));
   return m;
 }
@@ -140,8 +172,8 @@ Map1D elevate_map(const KnotVector& kv, int by) {
   const KnotVector to = KnotVector::from_breakpoints(kv.order() + by, br);
   // A clamped vector's clamp map is the identity: skip the dense product (cubic in the size,
   // minutes for the thousand-span curves of fillets).
-  if (kv.clamped()) return {to, detail::transfer_matrix(c.to, to)};
-  return {to, detail::transfer_matrix(c.to, to) * c.T};
+  if (kv.clamped()) return {to, detail::Banded::from_dense(detail::transfer_matrix(c.to, to))};
+  return {to, detail::Banded::from_dense(detail::transfer_matrix(c.to, to) * c.T.dense())};
 }
 
 template <int P>
@@ -340,9 +372,10 @@ template <int P>
 TensorSpline<P> to_space(const TensorSpline<P>& s, int dir, const KnotVector& target) {
   check_dir(s, dir);
   if (s.knots(dir) == target) return s;
-  if (s.knots(dir).clamped()) return apply_map(s, dir, Map1D{target, detail::transfer_matrix(s.knots(dir), target)});
+  if (s.knots(dir).clamped())
+    return apply_map(s, dir, Map1D{target, detail::Banded::from_dense(detail::transfer_matrix(s.knots(dir), target))});
   const Map1D c = clamp_map(s.knots(dir));
-  return apply_map(s, dir, Map1D{target, detail::transfer_matrix(c.to, target) * c.T});
+  return apply_map(s, dir, Map1D{target, detail::Banded::from_dense(detail::transfer_matrix(c.to, target) * c.T.dense())});
 }
 
 template <int P>

@@ -217,6 +217,84 @@ template Net<3> to_net(const TensorSpline<3>&);
 template TensorSpline<1> from_net<1>(std::array<KnotVector, 1>, int, bool, Net<1>);
 template TensorSpline<2> from_net<2>(std::array<KnotVector, 2>, int, bool, Net<2>);
 template TensorSpline<3> from_net<3>(std::array<KnotVector, 3>, int, bool, Net<3>);
+Banded Banded::identity(int n) {
+  Banded b;
+  b.cols = n;
+  const double one = 1.0;
+  for (int i = 0; i < n; ++i) b.push_row(i, &one, 1);
+  return b;
+}
+
+Banded Banded::from_dense(const Eigen::MatrixXd& T) {
+  Banded b;
+  b.cols = static_cast<int>(T.cols());
+  std::vector<double> row;
+  for (Eigen::Index j = 0; j < T.rows(); ++j) {
+    Eigen::Index a = 0, e = T.cols() - 1;
+    while (a < T.cols() && T(j, a) == 0.0) ++a;
+    while (e > a && T(j, e) == 0.0) --e;
+    row.clear();
+    for (Eigen::Index i = a; i <= e && a < T.cols(); ++i) row.push_back(T(j, i));
+    b.push_row(a < T.cols() ? static_cast<int>(a) : 0, row.data(), row.size());
+  }
+  return b;
+}
+
+Eigen::MatrixXd Banded::dense() const {
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(rows(), cols);
+  for (int j = 0; j < rows(); ++j)
+    for (std::size_t k = start[static_cast<std::size_t>(j)]; k < start[static_cast<std::size_t>(j) + 1]; ++k)
+      T(j, first[static_cast<std::size_t>(j)] + static_cast<Eigen::Index>(k - start[static_cast<std::size_t>(j)])) = vals[k];
+  return T;
+}
+
+Banded Banded::middle_rows(int from, int count) const {
+  Banded b;
+  b.cols = cols;
+  for (int j = from; j < from + count; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    b.push_row(first[uj], vals.data() + start[uj], start[uj + 1] - start[uj]);
+  }
+  return b;
+}
+
+template <int P>
+Net<P> apply_along(const Net<P>& net, int d, const Banded& T) {
+  const auto dd = static_cast<std::size_t>(d);
+  const int n = net.extents[dd];
+  const int m = T.rows();
+  if (T.cols != n) throw Error("internal: transfer matrix has " + std::to_string(T.cols) + " columns; expected " + std::to_string(n));
+  std::ptrdiff_t inner = 1, outer = 1;
+  for (int e = 0; e < d; ++e) inner *= net.extents[static_cast<std::size_t>(e)];
+  for (int e = d + 1; e < P; ++e) outer *= net.extents[static_cast<std::size_t>(e)];
+  Net<P> out;
+  out.extents = net.extents;
+  out.extents[dd] = m;
+  out.H = net.H;
+  const std::ptrdiff_t H = net.H;
+  out.values.assign(static_cast<std::size_t>(outer * m * inner * H), 0.0);
+  for (std::ptrdiff_t o = 0; o < outer; ++o) {
+    const double* src = net.values.data() + o * n * inner * H;
+    double* dst = out.values.data() + o * m * inner * H;
+    for (int j = 0; j < m; ++j) {
+      double* drow = dst + j * inner * H;
+      const auto uj = static_cast<std::size_t>(j);
+      for (std::size_t k = T.start[uj]; k < T.start[uj + 1]; ++k) {
+        const double c = T.vals[k];
+        if (c == 0.0) continue;
+        const int i = T.first[uj] + static_cast<int>(k - T.start[uj]);
+        if (i < 0 || i >= n) throw Error("internal: banded transfer row " + std::to_string(j) + " reaches column " + std::to_string(i));
+        const double* srow = src + i * inner * H;
+        for (std::ptrdiff_t q = 0; q < inner * H; ++q) drow[q] += c * srow[q];
+      }
+    }
+  }
+  return out;
+}
+
+template Net<1> apply_along(const Net<1>&, int, const Banded&);
+template Net<2> apply_along(const Net<2>&, int, const Banded&);
+template Net<3> apply_along(const Net<3>&, int, const Banded&);
 template Net<1> apply_along(const Net<1>&, int, const Eigen::MatrixXd&);
 template Net<2> apply_along(const Net<2>&, int, const Eigen::MatrixXd&);
 template Net<3> apply_along(const Net<3>&, int, const Eigen::MatrixXd&);

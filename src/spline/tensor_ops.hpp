@@ -34,6 +34,36 @@ TensorSpline<P> from_net(std::array<KnotVector, P> knots, int dim, bool rational
 template <int P>
 Net<P> apply_along(const Net<P>& net, int d, const Eigen::MatrixXd& T);
 
+/// A banded m x n matrix, the form of refinement, restriction and elevation maps (a few
+/// non-zeros per row): row j holds columns first[j] .. first[j] + len - 1, its values
+/// vals[start[j] .. start[j + 1]). Memory and work O(non-zeros), where the dense matrix of a
+/// thousand-span knot vector's Bezier extraction is m n (hundreds of MB).
+struct Banded {
+  int cols = 0;
+  std::vector<int> first;
+  std::vector<std::size_t> start{0};  ///< rows() + 1 offsets into vals
+  std::vector<double> vals;
+
+  int rows() const noexcept { return static_cast<int>(first.size()); }
+  /// Appends a row whose non-zeros start at column `col`.
+  void push_row(int col, const double* v, std::size_t len) {
+    first.push_back(col);
+    vals.insert(vals.end(), v, v + len);
+    start.push_back(vals.size());
+  }
+  static Banded identity(int n);
+  /// Every row's span from its first to its last non-zero entry.
+  static Banded from_dense(const Eigen::MatrixXd& T);
+  Eigen::MatrixXd dense() const;
+  /// Rows first .. first + count - 1.
+  Banded middle_rows(int first, int count) const;
+};
+
+/// apply_along with a banded T: the same sums in the same order (each row's non-zero entries,
+/// by increasing column), so the same floats as with T.dense().
+template <int P>
+Net<P> apply_along(const Net<P>& net, int d, const Banded& T);
+
 /// The m x n matrix taking the coefficients of a spline in the space of `from` to its coefficients
 /// in the space of `to` (which must contain it: `to` is a refinement and/or elevation of `from` on
 /// the same domain). Knot insertion uses Boehm's algorithm (exact); other cases use collocation at
