@@ -175,3 +175,37 @@ TEST_CASE("make_compatible brings two splines into one space without changing th
   CHECK(deviation(x, a, same) < 1e-12);
   CHECK(deviation(y, b, same) < 1e-12);
 }
+
+TEST_CASE("knot insertion into thousands of spans and into order 1 leaves the function unchanged") {
+  // u: order 4 with 1500 uniform spans (as the fitted fillets' rails); v: order 1 (piecewise
+  // constant, 3 spans), where Boehm's rule degenerates to duplicating a coefficient.
+  std::vector<double> ku = {0, 0, 0, 0};
+  for (int i = 1; i < 1500; ++i) ku.push_back(i / 1500.0);
+  ku.insert(ku.end(), {1, 1, 1, 1});
+  const std::array<KnotVector, 2> knots{KnotVector(4, ku), KnotVector(1, {0.0, 0.25, 0.5, 1.0})};
+  const int n = knots[0].size() * knots[1].size();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  std::vector<double> pts(static_cast<std::size_t>(n * 2));
+  for (double& p : pts) p = U(rng);
+  const Surface s(knots, 2, std::move(pts));
+  // Every interior knot raised to full multiplicity, then the pieces: 1500 x 3 of them.
+  const auto pieces = bezier_pieces(s);
+  REQUIRE(pieces.size() == 1500u * 3u);
+  for (std::size_t k : {std::size_t{0}, std::size_t{777}, pieces.size() - 1}) {
+    const auto& b = pieces[k];
+    const double u = 0.3 * b.domain(0)[0] + 0.7 * b.domain(0)[1], v = 0.5 * (b.domain(1)[0] + b.domain(1)[1]);
+    const auto x = b.eval({u, v}), y = s.eval({u, v});
+    CHECK(std::abs(x[0] - y[0]) < 1e-12);
+    CHECK(std::abs(x[1] - y[1]) < 1e-12);
+  }
+  // Many knots at once, unsorted, repeated, next to the domain's ends and on existing knots.
+  const double many[] = {0.9995, 0.0001, 0.5, 0.5, 1.0 - 1e-9, 2.0 / 1500.0, 0.123456};
+  const auto r = refine(s, 0, many);
+  CHECK(r.count(0) == s.count(0) + 7);
+  CHECK(deviation(r, s, same) < 1e-12);
+  const auto c = insert_knot(s, 1, 0.75);
+  CHECK(c.count(1) == s.count(1) + 1);
+  CHECK(deviation(c, s, same) < 1e-12);
+  CHECK_THROWS_WITH(insert_knot(s, 1, 0.25), Catch::Contains("multiplicity"));
+}
