@@ -269,11 +269,43 @@ std::vector<double> restrict_net(const std::vector<double>& net, const std::arra
   return q;
 }
 
-/// Cartesian xyz of control point i of a geometry net.
-inline Vec3 cartesian(const double* net, int i, int H) {
-  const double* q = net + static_cast<std::ptrdiff_t>(i) * H;
-  const double w = H == 4 ? q[3] : 1.0;
-  return {q[0] / w, q[1] / w, q[2] / w};
+/// Both halves of a net split at the middle of direction d, from one de Casteljau triangle per
+/// line: the same values as restrict_line to [0, 1/2] and to [1/2, 1] (each step 0.5 x + 0.5 y,
+/// x the point of lower index), at half the work and without copies.
+/// @param P     the net: H coordinates per point, u fastest, orders ord
+/// @param L, R  the halves (as many values as P), written
+void split_half(const double* P, const std::array<int, 3>& ord, int H, int d, double* L, double* R) {
+  // Along d the net is `outer` blocks of n rows of `inner` contiguous values.
+  const int n = ord[static_cast<std::size_t>(d)];
+  const int inner = H * (d == 0 ? 1 : d == 1 ? ord[0] : ord[0] * ord[1]);
+  const int outer = d == 0 ? ord[1] * ord[2] : d == 1 ? ord[2] : 1;
+  const std::ptrdiff_t block = static_cast<std::ptrdiff_t>(n) * inner;
+  for (int o = 0; o < outer; ++o) {
+    const double* p = P + o * block;
+    double* l = L + o * block;
+    double* r = R + o * block;  // the triangle's working rows; row i ends as the right half's
+    std::copy(p, p + inner, l);
+    if (n == 1) std::copy(p, p + inner, r);
+    for (int k = 1; k < n; ++k) {
+      if (k == 1) {  // the first stage reads P
+        for (int j = 0; j < n - 1; ++j) {
+          const double* pj = p + static_cast<std::ptrdiff_t>(j) * inner;
+          const double* pj1 = pj + inner;
+          double* rj = r + static_cast<std::ptrdiff_t>(j) * inner;
+          for (int e = 0; e < inner; ++e) rj[e] = 0.5 * pj[e] + 0.5 * pj1[e];
+        }
+        std::copy(p + block - inner, p + block, r + block - inner);
+        std::copy(r, r + inner, l + inner);
+        continue;
+      }
+      for (int j = 0; j < n - k; ++j) {
+        double* rj = r + static_cast<std::ptrdiff_t>(j) * inner;
+        const double* rj1 = rj + inner;
+        for (int e = 0; e < inner; ++e) rj[e] = 0.5 * rj[e] + 0.5 * rj1[e];
+      }
+      std::copy(r, r + inner, l + static_cast<std::ptrdiff_t>(k) * inner);
+    }
+  }
 }
 
 struct Flatness {
@@ -285,50 +317,102 @@ struct Flatness {
   std::array<Vec3, 3> frame{};  ///< rows of the inverse of the affine map's matrix
 };
 
-/// How far a net is from an affine map of its parameters (control points against their Greville
-/// abscissae i / (order - 1), a tensor grid, so the least-squares fit separates per direction),
-/// and the boxes that hold it.
-Flatness flatness(const std::vector<double>& net, const std::array<int, 3>& ord, int H) {
-  const std::size_t n = static_cast<std::size_t>(ord[0] * ord[1] * ord[2]);
-  Flatness f;
+/// What the least-squares affine fit of nets of one order needs beyond the net: the control
+/// points' Greville abscissae i / (order - 1), centred, per direction (a tensor grid, so the fit
+/// separates per direction), and their squared sums over the grid. One per piece.
+struct FitTables {
+  std::array<int, 3> ord{};
+  int n = 0;
+  std::array<std::vector<double>, 3> xi;
+  Vec3 den{};
+
+  explicit FitTables(const std::array<int, 3>& o) : ord(o), n(o[0] * o[1] * o[2]) {
+    for (std::size_t d = 0; d < 3; ++d) {
+      xi[d].resize(static_cast<std::size_t>(o[d]));
+      for (int j = 0; j < o[d]; ++j) xi[d][static_cast<std::size_t>(j)] = o[d] > 1 ? double(j) / (o[d] - 1) - 0.5 : 0.0;
+    }
+    // Summed over the grid point after point (u fastest), as the fit sums.
+    for (int c = 0; c < o[2]; ++c)
+      for (int b = 0; b < o[1]; ++b)
+        for (int a = 0; a < o[0]; ++a) {
+          const double x[3] = {xi[0][static_cast<std::size_t>(a)], xi[1][static_cast<std::size_t>(b)], xi[2][static_cast<std::size_t>(c)]};
+          for (std::size_t d = 0; d < 3; ++d) den[d] += x[d] * x[d];
+        }
+  }
+};
+
+/// The least-squares affine map of a net's control points X (xyz, 3 per point) against their
+/// Greville abscissae: X ~ mean + sum_d A[d] xi_d, and the largest distance of a point from it.
+struct AffineFit {
+  Vec3 mean{};
+  std::array<Vec3, 3> A{};  ///< A[d]: the xyz change per unit of direction d
+  double deviation = 0.0;
+};
+
+AffineFit affine_fit(const double* X, const FitTables& T) {
+  AffineFit f;
+  const double n = T.n;
+  if (T.n & (T.n - 1)) {
+    for (int i = 0; i < T.n; ++i)
+      for (std::size_t d = 0; d < 3; ++d) f.mean[d] += X[3 * i + static_cast<int>(d)] / n;
+  } else {  // x / 2^k == x * 2^-k exactly: no divisions (orders 2 and 4)
+    const double r = 1.0 / n;
+    for (int i = 0; i < T.n; ++i)
+      for (std::size_t d = 0; d < 3; ++d) f.mean[d] += X[3 * i + static_cast<int>(d)] * r;
+  }
+  const auto& x0 = T.xi[0];
+  const auto& x1 = T.xi[1];
+  const auto& x2 = T.xi[2];
+  const std::size_t ou = x0.size(), ov = x1.size(), ow = x2.size();
+  const double* p = X;
+  for (std::size_t c = 0; c < ow; ++c)
+    for (std::size_t b = 0; b < ov; ++b)
+      for (std::size_t a = 0; a < ou; ++a, p += 3)
+        for (std::size_t k = 0; k < 3; ++k) {
+          const double e = p[k] - f.mean[k];
+          f.A[0][k] += x0[a] * e;
+          f.A[1][k] += x1[b] * e;
+          f.A[2][k] += x2[c] * e;
+        }
+  for (std::size_t d = 0; d < 3; ++d)
+    if (T.den[d] > 0.0)
+      for (std::size_t k = 0; k < 3; ++k) f.A[d][k] /= T.den[d];
+  // The largest squared distance, then one root (the root is monotonic: the same maximum).
+  double dev2_max = 0.0;
+  p = X;
+  for (std::size_t c = 0; c < ow; ++c)
+    for (std::size_t b = 0; b < ov; ++b)
+      for (std::size_t a = 0; a < ou; ++a, p += 3) {
+        double dev2 = 0.0;
+        for (std::size_t k = 0; k < 3; ++k) {
+          const double e = p[k] - f.mean[k] - f.A[0][k] * x0[a] - f.A[1][k] * x1[b] - f.A[2][k] * x2[c];
+          dev2 += e * e;
+        }
+        dev2_max = std::max(dev2_max, dev2);
+      }
+  f.deviation = std::sqrt(dev2_max);
+  return f;
+}
+
+/// The control points' xyz box and its diagonal.
+void control_box(const double* X, int n, Flatness& f) {
   f.box_lo = {inf, inf, inf};
   f.box_hi = {-inf, -inf, -inf};
-  std::vector<Vec3> X(n);
-  std::vector<std::array<double, 3>> xi(n);  // Greville abscissae, centred
-  Vec3 mean{};
-  for (std::size_t i = 0; i < n; ++i) {
-    X[i] = cartesian(net.data(), static_cast<int>(i), H);
-    const int idx[3] = {static_cast<int>(i) % ord[0], (static_cast<int>(i) / ord[0]) % ord[1], static_cast<int>(i) / (ord[0] * ord[1])};
+  for (int i = 0; i < n; ++i)
     for (std::size_t d = 0; d < 3; ++d) {
-      xi[i][d] = ord[d] > 1 ? double(idx[d]) / (ord[d] - 1) - 0.5 : 0.0;
-      mean[d] += X[i][d] / static_cast<double>(n);
-      f.box_lo[d] = std::min(f.box_lo[d], X[i][d]);
-      f.box_hi[d] = std::max(f.box_hi[d], X[i][d]);
+      f.box_lo[d] = std::min(f.box_lo[d], X[3 * i + static_cast<int>(d)]);
+      f.box_hi[d] = std::max(f.box_hi[d], X[3 * i + static_cast<int>(d)]);
     }
-  }
-  std::array<Vec3, 3> A{};  // A[d]: the xyz change per unit of direction d
-  for (std::size_t d = 0; d < 3; ++d) {
-    double den = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      den += xi[i][d] * xi[i][d];
-      for (std::size_t k = 0; k < 3; ++k) A[d][k] += xi[i][d] * (X[i][k] - mean[k]);
-    }
-    if (den > 0.0)
-      for (std::size_t k = 0; k < 3; ++k) A[d][k] /= den;
-  }
   double diag2 = 0.0;
   for (std::size_t d = 0; d < 3; ++d) diag2 += (f.box_hi[d] - f.box_lo[d]) * (f.box_hi[d] - f.box_lo[d]);
   f.diagonal = std::sqrt(diag2);
-  for (std::size_t i = 0; i < n; ++i) {
-    double dev2 = 0.0;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double e = X[i][k] - mean[k] - A[0][k] * xi[i][0] - A[1][k] * xi[i][1] - A[2][k] * xi[i][2];
-      dev2 += e * e;
-    }
-    f.deviation = std::max(f.deviation, std::sqrt(dev2));
-  }
-  // Frame: the inverse of [A0 A1 A2] (rows = cross products / det), or the identity when the
-  // affine map is (nearly) degenerate.
+}
+
+/// The parallelepiped of the fit's frame that holds the control points X: the frame is the
+/// inverse of [A0 A1 A2] (rows = cross products / det), or the identity when the affine map is
+/// (nearly) degenerate.
+void fit_frame(const double* X, int n, const AffineFit& fit, Flatness& f) {
+  const auto& A = fit.A;
   auto cross = [](const Vec3& a, const Vec3& b) { return Vec3{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; };
   auto len = [](const Vec3& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); };
   const Vec3 c0 = cross(A[1], A[2]), c1 = cross(A[2], A[0]), c2 = cross(A[0], A[1]);
@@ -342,16 +426,29 @@ Flatness flatness(const std::vector<double>& net, const std::array<int, 3>& ord,
   } else {
     f.frame = {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
   }
+  const Vec3& mean = fit.mean;
   f.origin = mean;
   f.frame_lo = {inf, inf, inf};
   f.frame_hi = {-inf, -inf, -inf};
-  for (std::size_t i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
+    const double* x = X + 3 * i;
     for (std::size_t k = 0; k < 3; ++k) {
-      const double c = f.frame[k][0] * (X[i][0] - mean[0]) + f.frame[k][1] * (X[i][1] - mean[1]) + f.frame[k][2] * (X[i][2] - mean[2]);
+      const double c = f.frame[k][0] * (x[0] - mean[0]) + f.frame[k][1] * (x[1] - mean[1]) + f.frame[k][2] * (x[2] - mean[2]);
       f.frame_lo[k] = std::min(f.frame_lo[k], c);
       f.frame_hi[k] = std::max(f.frame_hi[k], c);
     }
-  return f;
+  }
+}
+
+/// The xyz of a geometry net's control points (3 per point): the net itself when polynomial
+/// (H = 3), else into `buf` (n * 3 values) divided by the weights.
+const double* cartesian_points(const double* net, int n, int H, double* buf) {
+  if (H == 3) return net;
+  for (int i = 0; i < n; ++i) {
+    const double* q = net + 4 * i;
+    for (int k = 0; k < 3; ++k) buf[3 * i + k] = q[k] / q[3];
+  }
+  return buf;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -570,70 +667,126 @@ struct CellBuild {
   std::vector<LocatorLeaf> leaves;  // piece = local index until merged
 };
 
+/// A leaf of build_leaves: its box in the piece's local [0,1]^3 and its regions.
+struct LeafBox {
+  Vec3 lo, hi;
+  Flatness f;
+};
+
 /// Subdivides a piece's parameter box (local [0,1]^3) into nearly affine leaves: deviation from
 /// affine at most 10% of the leaf's diagonal and, when `max_dev` > 0, at most max_dev; then, when
 /// 0 < fine_dev < max_dev, on towards fine_dev with at most fine_factor times as many leaves
 /// (the most deviating split first, so a budget that runs out leaves the piece evenly refined).
-void build_leaves(const std::vector<double>& net, const std::array<int, 3>& ord, int H, double min_diag, double max_dev,
-                  double fine_dev, int fine_factor, int max_leaves, std::vector<std::pair<std::array<Vec3, 2>, Flatness>>& out) {
+/// Cost per split: one de Casteljau triangle and one or two affine fits per direction tried; the
+/// frames only for the leaves. Nets live in one slab of reused slots (no allocation per split).
+/// @param net  the piece's geometry net: H coordinates per control point, u fastest
+void build_leaves(const double* net, const std::array<int, 3>& ord, int H, double min_diag, double max_dev, double fine_dev,
+                  int fine_factor, int max_leaves, std::vector<LeafBox>& out) {
   constexpr double flat = 0.1;  // deviation / diagonal at which a leaf is flat enough
+  const FitTables T(ord);
+  const int n = T.n;
+  const std::size_t size = static_cast<std::size_t>(n) * static_cast<std::size_t>(H);
   struct Item {
     Vec3 lo, hi;
-    std::vector<double> net;
-    Flatness f;
+    int slot;  // its net in the slab
+    AffineFit fit;
+    Flatness f;  // deviation, diagonal and box; the frame is filled for the leaves at the end
   };
-  auto less = [](const Item& a, const Item& b) { return a.f.deviation < b.f.deviation; };
-  std::vector<Item> work, done;
+  std::vector<double> slab;
+  std::vector<int> free_slots;
+  auto take = [&] {
+    if (!free_slots.empty()) {
+      const int s = free_slots.back();
+      free_slots.pop_back();
+      return s;
+    }
+    const int s = static_cast<int>(slab.size() / size);
+    slab.resize(slab.size() + size);
+    return s;
+  };
+  auto at = [&](int slot) { return slab.data() + static_cast<std::ptrdiff_t>(slot) * static_cast<std::ptrdiff_t>(size); };
+  std::vector<double> xyz(H == 3 ? 0 : static_cast<std::size_t>(n) * 3);  // cartesian points of rational nets
+  auto points = [&](int slot) { return cartesian_points(at(slot), n, H, xyz.data()); };
+
+  // The heap and the lists hold small records (deviation, item); the items stay in place.
+  struct Ref {
+    double deviation;
+    int item;
+  };
+  auto less = [](const Ref& a, const Ref& b) { return a.deviation < b.deviation; };
+  std::vector<Item> items;
+  std::vector<Ref> work, done;
   // Splits the most deviating item until every one is flat enough for dev_limit or the budget
   // of `cap` leaves is spent.
   auto refine = [&](double dev_limit, int cap) {
     while (!work.empty()) {
       std::pop_heap(work.begin(), work.end(), less);
-      Item it = std::move(work.back());
+      const Ref ref = work.back();
       work.pop_back();
+      const Item& it = items[static_cast<std::size_t>(ref.item)];
       const bool flat_enough = it.f.deviation <= flat * it.f.diagonal && (dev_limit <= 0.0 || it.f.deviation <= dev_limit);
       const bool stop = flat_enough || it.f.diagonal < min_diag || static_cast<int>(done.size() + work.size()) + 2 > cap;
       if (stop) {
-        done.push_back(std::move(it));
+        done.push_back(ref);
         continue;
       }
       // Split the direction whose halves come out flattest (absolute deviation: splitting a
-      // direction along which the net is already straight leaves the deviation as it is).
+      // direction along which the net is already straight leaves the deviation as it is). A
+      // direction whose first half already deviates as much as the best so far cannot win.
       int best = -1;
       double best_dev = inf;
+      int best_slots[2] = {take(), take()}, try_slots[2] = {take(), take()};
+      AffineFit best_fit[2], try_fit[2];
       for (int d = 0; d < 3; ++d) {
         if (ord[static_cast<std::size_t>(d)] < 2) continue;
+        split_half(at(it.slot), ord, H, d, at(try_slots[0]), at(try_slots[1]));
         double dev = 0.0;
-        for (int side = 0; side < 2; ++side) {
-          Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
-          (side ? lo : hi)[static_cast<std::size_t>(d)] = 0.5;
-          dev = std::max(dev, flatness(restrict_net(it.net, ord, H, lo, hi), ord, H).deviation);
+        for (int side = 0; side < 2 && dev < best_dev; ++side) {
+          try_fit[side] = affine_fit(points(try_slots[side]), T);
+          dev = std::max(dev, try_fit[side].deviation);
         }
         if (dev < best_dev) {
           best_dev = dev;
           best = d;
+          std::swap(best_slots, try_slots);
+          std::swap(best_fit, try_fit);
         }
       }
+      free_slots.push_back(try_slots[0]);
+      free_slots.push_back(try_slots[1]);
       if (best < 0) {
-        done.push_back(std::move(it));
+        free_slots.push_back(best_slots[0]);
+        free_slots.push_back(best_slots[1]);
+        done.push_back(ref);
         continue;
       }
+      free_slots.push_back(it.slot);
+      const Vec3 lo = it.lo, hi = it.hi;  // `it` dies when items grows
       for (int side = 0; side < 2; ++side) {
-        Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
-        (side ? lo : hi)[static_cast<std::size_t>(best)] = 0.5;
         Item child;
-        child.net = restrict_net(it.net, ord, H, lo, hi);
-        child.f = flatness(child.net, ord, H);
-        child.lo = it.lo;
-        child.hi = it.hi;
-        const double mid = 0.5 * (it.lo[static_cast<std::size_t>(best)] + it.hi[static_cast<std::size_t>(best)]);
+        child.slot = best_slots[side];
+        child.fit = best_fit[side];
+        child.f.deviation = child.fit.deviation;
+        control_box(points(child.slot), n, child.f);
+        child.lo = lo;
+        child.hi = hi;
+        const double mid = 0.5 * (lo[static_cast<std::size_t>(best)] + hi[static_cast<std::size_t>(best)]);
         (side ? child.lo : child.hi)[static_cast<std::size_t>(best)] = mid;
-        work.push_back(std::move(child));
+        items.push_back(child);
+        work.push_back({child.f.deviation, static_cast<int>(items.size()) - 1});
         std::push_heap(work.begin(), work.end(), less);
       }
     }
   };
-  work.push_back({{0, 0, 0}, {1, 1, 1}, net, flatness(net, ord, H)});
+  {
+    Item root{{0, 0, 0}, {1, 1, 1}, take(), {}, {}};
+    std::copy(net, net + size, at(root.slot));
+    root.fit = affine_fit(points(root.slot), T);
+    root.f.deviation = root.fit.deviation;
+    control_box(points(root.slot), n, root.f);
+    items.push_back(root);
+    work.push_back({root.f.deviation, 0});
+  }
   refine(max_dev, max_leaves);
   if (fine_dev > 0.0 && (max_dev <= 0.0 || fine_dev < max_dev) && fine_factor > 1) {
     const int cap = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(max_leaves), done.size() * static_cast<std::size_t>(fine_factor)));
@@ -642,7 +795,12 @@ void build_leaves(const std::vector<double>& net, const std::array<int, 3>& ord,
     std::make_heap(work.begin(), work.end(), less);
     refine(fine_dev, cap);
   }
-  for (const auto& it : done) out.push_back({{it.lo, it.hi}, it.f});
+  out.reserve(out.size() + done.size());
+  for (const auto& ref : done) {
+    auto& it = items[static_cast<std::size_t>(ref.item)];
+    fit_frame(points(it.slot), n, it.fit, it.f);
+    out.push_back({it.lo, it.hi, it.f});
+  }
 }
 
 /// Bounds on the second partials of a polynomial piece (net: nc = 3 + m coordinates per point):
@@ -810,17 +968,17 @@ CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const Locat
     // The local bounds (local_div^3 sub-boxes) are computed on first use (step_bounds): a
     // model of thousands of pieces would otherwise pay seconds here for pieces no voxel needs.
     if (pc.k.all_first) pc.bounds = step_bounds_of(all, pc, m);
-    std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
-    build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
-    for (const auto& [box, fl] : lv) {
+    std::vector<LeafBox> lv;
+    build_leaves(g.data(), pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
+    for (const auto& [lo, hi, fl] : lv) {
       LocatorLeaf leaf;
       leaf.cell = cell_index;
       leaf.piece = static_cast<int>(pi);
       for (int d = 0; d < 3; ++d) {
         const auto dd = static_cast<std::size_t>(d);
         // The piece's own end knots at the ends, so leaves tile the domain without gaps.
-        leaf.lo[dd] = box[0][dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + box[0][dd] * pc.len[dd];
-        leaf.hi[dd] = box[1][dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + box[1][dd] * pc.len[dd];
+        leaf.lo[dd] = lo[dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + lo[dd] * pc.len[dd];
+        leaf.hi[dd] = hi[dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + hi[dd] * pc.len[dd];
       }
       leaf.box_lo = fl.box_lo;
       leaf.box_hi = fl.box_hi;
