@@ -532,6 +532,7 @@ void solve_free(const double J[3][3], const double* r, const bool* free, double*
 // ---------------------------------------------------------------------------------------------
 
 struct Locator::Data {
+  static constexpr int local_div = 8;
   struct Piece {
     int cell = 0;
     std::array<int, 3> order{};
@@ -541,12 +542,14 @@ struct Locator::Data {
     Kernels k;
     std::size_t net = 0;  ///< offset into the pool
     Vec3 lipschitz{};     ///< bounds on |dX/dt_d| (global parameters); inf if rational
-    StepBounds bounds;    ///< second-derivative bounds (polynomial pieces with all_first)
+    /// Second-derivative bounds (polynomial pieces with all_first): computed on first use,
+    /// under bounds_once (a job touches only some pieces; the values do not depend on which
+    /// thread computes them).
+    mutable StepBounds bounds;
     /// Tighter bounds near a point: the piece cut into local_div^3 sub-boxes, and for each the
     /// bounds over it and its neighbours (up to 3 x 3 x 3 sub-boxes); empty without `bounds`.
     mutable std::vector<StepBounds> local;  ///< filled on first use, under local_once
   };
-  static constexpr int local_div = 8;
   struct Cell {
     std::array<std::vector<double>, 3> breaks;  ///< distinct knots inside the domain
     std::array<int, 3> spans{};
@@ -578,7 +581,8 @@ struct Locator::Data {
   bool any_trim = false;
   std::vector<Cell> cells;
   std::vector<Piece> pieces;
-  std::unique_ptr<std::once_flag[]> local_once;  ///< one per piece: its local bounds computed
+  std::unique_ptr<std::once_flag[]> bounds_once;  ///< one per piece: its bounds computed
+  std::unique_ptr<std::once_flag[]> local_once;   ///< one per piece: its local bounds computed
   bool use_local = true;                         ///< false: whole-piece bounds only (memory)
   std::vector<double> pool;  ///< every piece's net, control point after control point
   std::vector<LocatorLeaf> leaves;
@@ -659,13 +663,6 @@ private:
 namespace {
 
 using Data = Locator::Data;
-
-struct CellBuild {
-  Data::Cell cell;
-  std::vector<Data::Piece> pieces;
-  std::vector<std::vector<double>> nets;
-  std::vector<LocatorLeaf> leaves;  // piece = local index until merged
-};
 
 /// A leaf of build_leaves: its box in the piece's local [0,1]^3 and its regions.
 struct LeafBox {
@@ -805,8 +802,9 @@ void build_leaves(const double* net, const std::array<int, 3>& ord, int H, doubl
 
 /// Bounds on the second partials of a polynomial piece (net: nc = 3 + m coordinates per point):
 /// d^2/dt_d dt_e is a Bezier polynomial with control points (scaled) second differences of the
-/// net, so their largest norm bounds it (convex hull property).
-StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::Piece& pc, int m) {
+/// net, so their largest norm bounds it (convex hull property). The largest squared norm is
+/// kept and its root taken once (the root is monotonic: the same bound).
+StepBounds second_derivative_bounds(const double* net, const Data::Piece& pc) {
   StepBounds b;
   b.valid = true;
   for (std::size_t d = 0; d < 3; ++d) {
@@ -816,51 +814,56 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
   const auto& o = pc.order;
   const int nc = pc.nc;
   const int stride[3] = {1, o[0], o[0] * o[1]};
-  const int n = o[0] * o[1] * o[2];
   for (int d = 0; d < 3; ++d)
     for (int e = d; e < 3; ++e) {
       const auto ud = static_cast<std::size_t>(d), ue = static_cast<std::size_t>(e);
       const double factor = d == e ? (o[ud] - 1.0) * (o[ud] - 2.0) * pc.inv_len[ud] * pc.inv_len[ud]
                                    : (o[ud] - 1.0) * (o[ue] - 1.0) * pc.inv_len[ud] * pc.inv_len[ue];
-      double bx = 0.0, bp = 0.0, bv[3] = {0.0, 0.0, 0.0};
+      double bx2 = 0.0, bp = 0.0, bv[3] = {0.0, 0.0, 0.0};
+      // The second difference at point i, over the points where it exists: d == e: P_i -
+      // 2 P_i+s + P_i+2s; d != e: P_i - P_i+sd - P_i+se + P_i+sd+se (in this order; only their
+      // magnitudes are used).
+      std::array<int, 3> lim = o;
+      std::ptrdiff_t o1, o2, o3 = 0;
+      if (d == e) {
+        lim[ud] -= 2;
+        o1 = static_cast<std::ptrdiff_t>(stride[d]) * nc;
+        o2 = 2 * o1;
+      } else {
+        lim[ud] -= 1;
+        lim[ue] -= 1;
+        o1 = static_cast<std::ptrdiff_t>(stride[d]) * nc;
+        o2 = static_cast<std::ptrdiff_t>(stride[e]) * nc;
+        o3 = o1 + o2;
+      }
       if (factor != 0.0)
-        for (int i = 0; i < n; ++i) {
-          const int idx[3] = {i % o[0], (i / o[0]) % o[1], i / (o[0] * o[1])};
-          // Corner offsets of the second difference: d == e: i, i+s, i+2s (1, -2, 1);
-          // d != e: i, i+sd, i+se, i+sd+se (1, -1, -1, 1).
-          int off[4];
-          double w[4];
-          int terms;
-          if (d == e) {
-            if (idx[d] + 2 >= o[ud]) continue;
-            off[0] = i, off[1] = i + stride[d], off[2] = i + 2 * stride[d];
-            w[0] = 1, w[1] = -2, w[2] = 1;
-            terms = 3;
-          } else {
-            if (idx[d] + 1 >= o[ud] || idx[e] + 1 >= o[ue]) continue;
-            off[0] = i, off[1] = i + stride[d], off[2] = i + stride[e], off[3] = i + stride[d] + stride[e];
-            w[0] = 1, w[1] = -1, w[2] = -1, w[3] = 1;
-            terms = 4;
-          }
-          double x2 = 0.0;
-          for (int h = 0; h < nc; ++h) {
-            double v = 0.0;
-            for (int k = 0; k < terms; ++k) v += w[k] * net[static_cast<std::size_t>(off[k] * nc + h)];
-            if (h < 3) {
-              x2 += v * v;
-              bv[h] = std::max(bv[h], std::abs(v));
-            } else {
-              bp = std::max(bp, std::abs(v));
+        for (int c = 0; c < lim[2]; ++c)
+          for (int bb = 0; bb < lim[1]; ++bb) {
+            const double* p = net + static_cast<std::ptrdiff_t>(o[0] * (bb + o[1] * c)) * nc;
+            for (int a = 0; a < lim[0]; ++a, p += nc) {
+              double v[3];
+              if (d == e)
+                for (int h = 0; h < 3; ++h) v[h] = p[h] + -2.0 * p[o1 + h] + p[o2 + h];
+              else
+                for (int h = 0; h < 3; ++h) v[h] = p[h] - p[o1 + h] - p[o2 + h] + p[o3 + h];
+              double x2 = 0.0;
+              for (int h = 0; h < 3; ++h) {
+                x2 += v[h] * v[h];
+                bv[h] = std::max(bv[h], std::abs(v[h]));
+              }
+              bx2 = std::max(bx2, x2);
+              if (d == e)
+                for (int h = 3; h < nc; ++h) bp = std::max(bp, std::abs(p[h] + -2.0 * p[o1 + h] + p[o2 + h]));
+              else
+                for (int h = 3; h < nc; ++h) bp = std::max(bp, std::abs(p[h] - p[o1 + h] - p[o2 + h] + p[o3 + h]));
             }
           }
-          bx = std::max(bx, std::sqrt(x2));
-        }
+      const double bx = std::sqrt(bx2);
       // Rounding in the differences is far below these bounds' slack; 1e-12 relative covers it.
       b.b2[ud][ue] = b.b2[ue][ud] = bx * factor * (1.0 + 1e-12);
       for (std::size_t k = 0; k < 3; ++k) b.b2v[ud][ue][k] = b.b2v[ue][ud][k] = bv[k] * factor * (1.0 + 1e-12);
       b.p2[ud][ue] = b.p2[ue][ud] = bp * factor * (1.0 + 1e-12);
     }
-  (void)m;
   for (std::size_t d = 0; d < 3; ++d)
     b.lip = std::max(b.lip, std::sqrt(b.b2[d][0] * b.b2[d][0] + b.b2[d][1] * b.b2[d][1] + b.b2[d][2] * b.b2[d][2]));
   return b;
@@ -868,32 +871,34 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
 
 /// Hodograph bound: |dX/dt_d| <= (order - 1) max |P_{i+1} - P_i| / len (polynomial nets with
 /// `stride` coordinates per point, xyz first).
-Vec3 hodograph_bounds(const std::vector<double>& net, const Data::Piece& pc, int stride) {
+Vec3 hodograph_bounds(const double* net, const Data::Piece& pc, int stride) {
   Vec3 out{};
-  const int n = pc.order[0] * pc.order[1] * pc.order[2];
+  const auto& o = pc.order;
   for (int d = 0; d < 3; ++d) {
     const auto dd = static_cast<std::size_t>(d);
-    if (pc.order[dd] < 2) continue;
-    const int step = d == 0 ? 1 : d == 1 ? pc.order[0] : pc.order[0] * pc.order[1];
-    double mx = 0.0;
-    for (int i = 0; i < n; ++i) {
-      const int idx = d == 0 ? i % pc.order[0] : d == 1 ? (i / pc.order[0]) % pc.order[1] : i / (pc.order[0] * pc.order[1]);
-      if (idx + 1 >= pc.order[dd]) continue;
-      double diff[3];
-      for (int h = 0; h < 3; ++h)
-        diff[h] = net[static_cast<std::size_t>((i + step) * stride + h)] - net[static_cast<std::size_t>(i * stride + h)];
-      mx = std::max(mx, norm3(diff));
-    }
+    if (o[dd] < 2) continue;
+    const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(d == 0 ? 1 : d == 1 ? o[0] : o[0] * o[1]) * stride;
+    std::array<int, 3> lim = o;
+    lim[dd] -= 1;
+    double mx2 = 0.0;  // the largest squared norm (one root at the end: the same maximum)
+    for (int c = 0; c < lim[2]; ++c)
+      for (int b = 0; b < lim[1]; ++b) {
+        const double* p = net + static_cast<std::ptrdiff_t>(o[0] * (b + o[1] * c)) * stride;
+        for (int a = 0; a < lim[0]; ++a, p += stride) {
+          const double diff[3] = {p[step] - p[0], p[step + 1] - p[1], p[step + 2] - p[2]};
+          mx2 = std::max(mx2, dot3(diff, diff));
+        }
+      }
     // The same 1e-12 relative slack as the second-derivative bounds, for rounding.
-    out[dd] = (pc.order[dd] - 1) * mx * pc.inv_len[dd] * (1.0 + 1e-12);
+    out[dd] = (o[dd] - 1) * std::sqrt(mx2) * pc.inv_len[dd] * (1.0 + 1e-12);
   }
   return out;
 }
 
 /// Everything the sampler's certificates need of a polynomial piece (or part of one: `pc` gives
 /// the parameter box of `net`, nc = 3 + m coordinates per point).
-StepBounds step_bounds_of(const std::vector<double>& net, const Data::Piece& pc, int m) {
-  StepBounds b = second_derivative_bounds(net, pc, m);
+StepBounds step_bounds_of(const double* net, const Data::Piece& pc) {
+  StepBounds b = second_derivative_bounds(net, pc);
   b.slope = hodograph_bounds(net, pc, pc.nc);
   for (std::size_t d = 0; d < 3; ++d) b.degree[d] = pc.order[d] - 1;
   return b;
@@ -901,10 +906,14 @@ StepBounds step_bounds_of(const std::vector<double>& net, const Data::Piece& pc,
 
 /// The bounds over each of the local_div^3 sub-boxes of a piece and its neighbours (StepBounds
 /// of the restricted nets).
-std::vector<StepBounds> local_bounds(const std::vector<double>& all, const Data::Piece& pc, int m) {
+/// @param net  the piece's net, nc coordinates per control point
+std::vector<StepBounds> local_bounds(const double* net, const Data::Piece& pc) {
   std::vector<StepBounds> local(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
-  Data::Piece sub = pc;
-  sub.local.clear();
+  const std::vector<double> all(net, net + pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+  // The fields step_bounds_of reads (not a copy of pc: its lazy members may be being written).
+  Data::Piece sub;
+  sub.order = pc.order;
+  sub.nc = pc.nc;
   constexpr double S = Data::local_div;
   for (int c = 0; c < Data::local_div; ++c)
     for (int b = 0; b < Data::local_div; ++b)
@@ -919,81 +928,93 @@ std::vector<StepBounds> local_bounds(const std::vector<double>& all, const Data:
           sub.inv_len[d] = 1.0 / sub.len[d];
         }
         local[static_cast<std::size_t>(a + Data::local_div * (b + Data::local_div * c))] =
-            step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi), sub, m);
+            step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi).data(), sub);
       }
   return local;
 }
 
-CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const LocatorOptions& opt) {
+/// A cell's Bezier pieces, before they are built.
+struct CellPieces {
+  Data::Cell cell;
+  std::vector<spline::TensorSpline<3>> pieces;
+  int H = 3;  ///< geometry coordinates: 4 for a rational cell
+};
+
+/// The cell's domain, breakpoints and Bezier pieces.
+CellPieces cell_pieces(const vmodel::VCell& vc) {
   const auto& s = vc.volume;
-  CellBuild cb;
+  CellPieces cp;
   for (int d = 0; d < 3; ++d) {
     const auto dd = static_cast<std::size_t>(d);
     if (s.knots(d).order() > max_order)
       throw Error("cell " + vc.name + ": order " + std::to_string(s.knots(d).order()) + " in direction " + "uvw"[d] +
                   "; expected at most " + std::to_string(max_order) + " for point location");
-    for (const auto& br : s.knots(d).breakpoints()) cb.cell.breaks[dd].push_back(br.value);
-    cb.cell.spans[dd] = static_cast<int>(cb.cell.breaks[dd].size()) - 1;
-    cb.cell.lo[dd] = s.domain(d)[0];
-    cb.cell.hi[dd] = s.domain(d)[1];
+    for (const auto& br : s.knots(d).breakpoints()) cp.cell.breaks[dd].push_back(br.value);
+    cp.cell.spans[dd] = static_cast<int>(cp.cell.breaks[dd].size()) - 1;
+    cp.cell.lo[dd] = s.domain(d)[0];
+    cp.cell.hi[dd] = s.domain(d)[1];
   }
-  const auto pieces = spline::bezier_pieces(s);
-  const int H = s.rational() ? 4 : 3;
+  cp.pieces = spline::bezier_pieces(s);
+  cp.H = s.rational() ? 4 : 3;
+  return cp;
+}
+
+/// Builds one Bezier piece: its Piece record, its net (written to `pool`, pc.net values on) and
+/// its leaves (appended to `leaves`). The whole-piece StepBounds are left to first use.
+/// @param piece_index  the piece's index among all pieces of the locator
+/// @param H            the cell's geometry coordinates (CellPieces::H)
+Data::Piece build_piece(const spline::TensorSpline<3>& bp, int H, int cell_index, int piece_index, std::size_t net, int m,
+                        const LocatorOptions& opt, double* pool, std::vector<LocatorLeaf>& leaves) {
+  Data::Piece pc;
+  pc.cell = cell_index;
+  pc.order = bp.orders();
+  pc.H = H;
+  pc.nc = H + m;
+  pc.net = net;
+  pc.k = H == 3 ? pick_kernels<3>(pc.order, pc.nc) : pick_kernels<4>(pc.order, pc.nc);
+  for (int d = 0; d < 3; ++d) {
+    const auto dd = static_cast<std::size_t>(d);
+    pc.lo[dd] = bp.domain(d)[0];
+    pc.len[dd] = bp.domain(d)[1] - bp.domain(d)[0];
+    pc.inv_len[dd] = 1.0 / pc.len[dd];
+  }
+  const int n = bp.size();
+  std::vector<double> g(static_cast<std::size_t>(n * H));
+  double* all = pool + net;
+  for (int i = 0; i < n; ++i) {
+    const auto q = bp.point(i);
+    const double w = H == 4 ? bp.weights()[static_cast<std::size_t>(i)] : 1.0;
+    for (int h = 0; h < 3; ++h) g[static_cast<std::size_t>(i * H + h)] = w * q[static_cast<std::size_t>(h)];
+    if (H == 4) g[static_cast<std::size_t>(i * H + 3)] = w;
+    for (int h = 0; h < H; ++h) all[i * pc.nc + h] = g[static_cast<std::size_t>(i * H + h)];
+    for (int h = 0; h < m; ++h) all[i * pc.nc + H + h] = w * q[static_cast<std::size_t>(3 + h)];
+  }
+  pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g.data(), pc, H);
+  std::vector<LeafBox> lv;
   const double min_diag = 100.0 * opt.tolerance;
-  for (std::size_t pi = 0; pi < pieces.size(); ++pi) {
-    const auto& bp = pieces[pi];
-    Data::Piece pc;
-    pc.cell = cell_index;
-    pc.order = bp.orders();
-    pc.H = H;
-    pc.nc = H + m;
-    pc.k = H == 3 ? pick_kernels<3>(pc.order, pc.nc) : pick_kernels<4>(pc.order, pc.nc);
+  build_leaves(g.data(), pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
+  leaves.reserve(lv.size());
+  for (const auto& [lo, hi, fl] : lv) {
+    LocatorLeaf leaf;
+    leaf.cell = cell_index;
+    leaf.piece = piece_index;
     for (int d = 0; d < 3; ++d) {
       const auto dd = static_cast<std::size_t>(d);
-      pc.lo[dd] = bp.domain(d)[0];
-      pc.len[dd] = bp.domain(d)[1] - bp.domain(d)[0];
-      pc.inv_len[dd] = 1.0 / pc.len[dd];
+      // The piece's own end knots at the ends, so leaves tile the domain without gaps.
+      leaf.lo[dd] = lo[dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + lo[dd] * pc.len[dd];
+      leaf.hi[dd] = hi[dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + hi[dd] * pc.len[dd];
     }
-    const int n = bp.size();
-    std::vector<double> g(static_cast<std::size_t>(n * H)), all(static_cast<std::size_t>(n * pc.nc));
-    for (int i = 0; i < n; ++i) {
-      const auto q = bp.point(i);
-      const double w = H == 4 ? bp.weights()[static_cast<std::size_t>(i)] : 1.0;
-      for (int h = 0; h < 3; ++h) g[static_cast<std::size_t>(i * H + h)] = w * q[static_cast<std::size_t>(h)];
-      if (H == 4) g[static_cast<std::size_t>(i * H + 3)] = w;
-      for (int h = 0; h < H; ++h) all[static_cast<std::size_t>(i * pc.nc + h)] = g[static_cast<std::size_t>(i * H + h)];
-      for (int h = 0; h < m; ++h) all[static_cast<std::size_t>(i * pc.nc + H + h)] = w * q[static_cast<std::size_t>(3 + h)];
-    }
-    pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g, pc, H);
-    // The local bounds (local_div^3 sub-boxes) are computed on first use (step_bounds): a
-    // model of thousands of pieces would otherwise pay seconds here for pieces no voxel needs.
-    if (pc.k.all_first) pc.bounds = step_bounds_of(all, pc, m);
-    std::vector<LeafBox> lv;
-    build_leaves(g.data(), pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
-    for (const auto& [lo, hi, fl] : lv) {
-      LocatorLeaf leaf;
-      leaf.cell = cell_index;
-      leaf.piece = static_cast<int>(pi);
-      for (int d = 0; d < 3; ++d) {
-        const auto dd = static_cast<std::size_t>(d);
-        // The piece's own end knots at the ends, so leaves tile the domain without gaps.
-        leaf.lo[dd] = lo[dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + lo[dd] * pc.len[dd];
-        leaf.hi[dd] = hi[dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + hi[dd] * pc.len[dd];
-      }
-      leaf.box_lo = fl.box_lo;
-      leaf.box_hi = fl.box_hi;
-      leaf.frame_origin = fl.origin;
-      leaf.frame = fl.frame;
-      leaf.frame_lo = fl.frame_lo;
-      leaf.frame_hi = fl.frame_hi;
-      for (std::size_t k = 0; k < 3; ++k)
-        leaf.frame_scale[k] = std::sqrt(fl.frame[k][0] * fl.frame[k][0] + fl.frame[k][1] * fl.frame[k][1] + fl.frame[k][2] * fl.frame[k][2]);
-      cb.leaves.push_back(leaf);
-    }
-    cb.pieces.push_back(pc);
-    cb.nets.push_back(std::move(all));
+    leaf.box_lo = fl.box_lo;
+    leaf.box_hi = fl.box_hi;
+    leaf.frame_origin = fl.origin;
+    leaf.frame = fl.frame;
+    leaf.frame_lo = fl.frame_lo;
+    leaf.frame_hi = fl.frame_hi;
+    for (std::size_t k = 0; k < 3; ++k)
+      leaf.frame_scale[k] = std::sqrt(fl.frame[k][0] * fl.frame[k][0] + fl.frame[k][1] * fl.frame[k][1] + fl.frame[k][2] * fl.frame[k][2]);
+    leaves.push_back(leaf);
   }
-  return cb;
+  return pc;
 }
 
 /// Median-split BVH over the leaf boxes.
@@ -1066,29 +1087,41 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
       throw Error("cell " + model.cells[static_cast<std::size_t>(c)].name + ": " +
                   std::to_string(model.cells[static_cast<std::size_t>(c)].volume.dim()) +
                   " coordinates per control point; expected " + std::to_string(model.dim()) + " (xyz and the model's properties)");
-  std::vector<CellBuild> built(static_cast<std::size_t>(nc));
-  tbb::parallel_for(0, nc, [&](int c) {
-    built[static_cast<std::size_t>(c)] = build_cell(model.cells[static_cast<std::size_t>(c)], c, D.m, opt_);
-  });
+  // Cells, then all pieces of all cells, in parallel; each piece writes its own pre-sized slots
+  // (its Piece, its part of the pool, its leaves), concatenated in order afterwards: the same
+  // locator whatever the thread count.
+  std::vector<CellPieces> cells(static_cast<std::size_t>(nc));
+  tbb::parallel_for(0, nc, [&](int c) { cells[static_cast<std::size_t>(c)] = cell_pieces(model.cells[static_cast<std::size_t>(c)]); });
+  struct Job {
+    int cell, local;
+  };
+  std::vector<Job> jobs;
+  std::vector<std::size_t> nets;  // pool offset per piece
   std::size_t size = 0;
-  for (auto& cb : built)
-    for (const auto& net : cb.nets) size += net.size();
-  D.pool.reserve(size);
-  for (auto& cb : built) {
-    cb.cell.first_piece = static_cast<int>(D.pieces.size());
-    for (auto& leaf : cb.leaves) {
-      leaf.piece += cb.cell.first_piece;
-      D.leaves.push_back(leaf);
+  for (int c = 0; c < nc; ++c) {
+    auto& cp = cells[static_cast<std::size_t>(c)];
+    cp.cell.first_piece = static_cast<int>(jobs.size());
+    for (std::size_t i = 0; i < cp.pieces.size(); ++i) {
+      jobs.push_back({c, static_cast<int>(i)});
+      nets.push_back(size);
+      size += static_cast<std::size_t>(cp.pieces[i].size()) * static_cast<std::size_t>(cp.H + D.m);
     }
-    for (std::size_t i = 0; i < cb.pieces.size(); ++i) {
-      auto pc = cb.pieces[i];
-      pc.net = D.pool.size();
-      D.pool.insert(D.pool.end(), cb.nets[i].begin(), cb.nets[i].end());
-      D.pieces.push_back(pc);
-    }
-    D.cells.push_back(std::move(cb.cell));
   }
+  D.pool.resize(size);
+  D.pieces.resize(jobs.size());
+  std::vector<std::vector<LocatorLeaf>> leaves(jobs.size());
+  tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t i) {
+    const auto& cp = cells[static_cast<std::size_t>(jobs[i].cell)];
+    D.pieces[i] = build_piece(cp.pieces[static_cast<std::size_t>(jobs[i].local)], cp.H, jobs[i].cell, static_cast<int>(i), nets[i], D.m,
+                              opt_, D.pool.data(), leaves[i]);
+  });
+  std::size_t total = 0;
+  for (const auto& l : leaves) total += l.size();
+  D.leaves.reserve(total);
+  for (const auto& l : leaves) D.leaves.insert(D.leaves.end(), l.begin(), l.end());
+  for (auto& cp : cells) D.cells.push_back(std::move(cp.cell));
   build_bvh(D);
+  D.bounds_once = std::make_unique<std::once_flag[]>(D.pieces.size());
   D.local_once = std::make_unique<std::once_flag[]>(D.pieces.size());
   // Local bounds cost local_div^3 StepBounds per piece (about 250 kB) and milliseconds to
   // compute: for models of thousands of pieces (finely refined cells) the whole-piece bounds
@@ -1275,17 +1308,18 @@ bool Locator::expand(int cell, const Vec3& t, Expansion& out) const {
   return true;
 }
 
-const StepBounds& Locator::step_bounds(int piece) const noexcept { return data_->pieces[static_cast<std::size_t>(piece)].bounds; }
+const StepBounds& Locator::step_bounds(int piece) const noexcept {
+  const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
+  if (!pc.k.all_first) return pc.bounds;  // not valid
+  std::call_once(data_->bounds_once[static_cast<std::size_t>(piece)],
+                 [&] { pc.bounds = step_bounds_of(data_->pool.data() + pc.net, pc); });
+  return pc.bounds;
+}
 
 const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
   const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
-  if (!pc.k.all_first || !data_->use_local) return pc.bounds;
-  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] {
-    const std::size_t n = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
-    const std::vector<double> all(data_->pool.begin() + static_cast<std::ptrdiff_t>(pc.net),
-                                  data_->pool.begin() + static_cast<std::ptrdiff_t>(pc.net + n));
-    pc.local = local_bounds(all, pc, data_->m);
-  });
+  if (!pc.k.all_first || !data_->use_local) return step_bounds(piece);
+  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] { pc.local = local_bounds(data_->pool.data() + pc.net, pc); });
   double s[3];
   Data::local(pc, t, s);
   int idx[3];
