@@ -255,18 +255,19 @@ void restrict_line(double* P, int n, int stride, int H, double a, double b) {
         for (int h = 0; h < H; ++h) at(i)[h] = (1.0 - t) * at(i)[h] + t * at(i + 1)[h];
 }
 
-/// The net (H coordinates per point, u fastest) restricted to the local box [lo, hi].
-std::vector<double> restrict_net(const std::vector<double>& net, const std::array<int, 3>& ord, int H, const Vec3& lo,
-                                 const Vec3& hi) {
-  std::vector<double> q = net;
+/// Restricts direction d of a net (H coordinates per point, u fastest, orders ord) to the local
+/// interval [a, b], in place: restrict_line on every line along d.
+void restrict_dir(double* q, const std::array<int, 3>& ord, int H, int d, double a, double b) {
   const int ou = ord[0], ov = ord[1], ow = ord[2];
-  for (int c = 0; c < ow; ++c)
-    for (int b = 0; b < ov; ++b) restrict_line(q.data() + (c * ov + b) * ou * H, ou, H, H, lo[0], hi[0]);
-  for (int c = 0; c < ow; ++c)
-    for (int a = 0; a < ou; ++a) restrict_line(q.data() + (c * ov * ou + a) * H, ov, ou * H, H, lo[1], hi[1]);
-  for (int b = 0; b < ov; ++b)
-    for (int a = 0; a < ou; ++a) restrict_line(q.data() + (b * ou + a) * H, ow, ou * ov * H, H, lo[2], hi[2]);
-  return q;
+  if (d == 0)
+    for (int c = 0; c < ow; ++c)
+      for (int j = 0; j < ov; ++j) restrict_line(q + (c * ov + j) * ou * H, ou, H, H, a, b);
+  else if (d == 1)
+    for (int c = 0; c < ow; ++c)
+      for (int i = 0; i < ou; ++i) restrict_line(q + (c * ov * ou + i) * H, ov, ou * H, H, a, b);
+  else
+    for (int j = 0; j < ov; ++j)
+      for (int i = 0; i < ou; ++i) restrict_line(q + (j * ou + i) * H, ow, ou * ov * H, H, a, b);
 }
 
 /// Both halves of a net split at the middle of direction d, from one de Casteljau triangle per
@@ -533,6 +534,15 @@ void solve_free(const double J[3][3], const double* r, const bool* free, double*
 
 struct Locator::Data {
   static constexpr int local_div = 8;
+  /// A piece's local bounds: the piece cut into local_div^3 sub-boxes, and for each the bounds
+  /// over it and its neighbours (up to 3 x 3 x 3 sub-boxes), each computed on first use under
+  /// its flag (a thin job meets only a few sub-boxes of a piece). The sub-box's net is the
+  /// piece's restricted along u, then v, then w; the local_div u restrictions are kept.
+  struct Local {
+    std::vector<double> u_nets;     ///< the net restricted along u to each u interval
+    std::vector<StepBounds> bounds;  ///< per sub-box, u fastest
+    std::unique_ptr<std::once_flag[]> done;  ///< per sub-box: its bounds computed
+  };
   struct Piece {
     int cell = 0;
     std::array<int, 3> order{};
@@ -546,9 +556,8 @@ struct Locator::Data {
     /// under bounds_once (a job touches only some pieces; the values do not depend on which
     /// thread computes them).
     mutable StepBounds bounds;
-    /// Tighter bounds near a point: the piece cut into local_div^3 sub-boxes, and for each the
-    /// bounds over it and its neighbours (up to 3 x 3 x 3 sub-boxes); empty without `bounds`.
-    mutable std::vector<StepBounds> local;  ///< filled on first use, under local_once
+    /// Tighter bounds near a point (see Local): created on first use, under local_once.
+    mutable std::unique_ptr<Local> local;
   };
   struct Cell {
     std::array<std::vector<double>, 3> breaks;  ///< distinct knots inside the domain
@@ -904,33 +913,47 @@ StepBounds step_bounds_of(const double* net, const Data::Piece& pc) {
   return b;
 }
 
-/// The bounds over each of the local_div^3 sub-boxes of a piece and its neighbours (StepBounds
-/// of the restricted nets).
-/// @param net  the piece's net, nc coordinates per control point
-std::vector<StepBounds> local_bounds(const double* net, const Data::Piece& pc) {
-  std::vector<StepBounds> local(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
-  const std::vector<double> all(net, net + pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+/// The local bounds' intervals: k-th sub-box and its neighbours, in the piece's local [0, 1].
+double local_lo(int k) { return std::max(0.0, (k - 1) / double(Data::local_div)); }
+double local_hi(int k) { return std::min(1.0, (k + 2) / double(Data::local_div)); }
+
+/// A piece's local bounds before any is computed: its net restricted along u to each interval.
+/// @param all  the piece's net, nc coordinates per control point
+std::unique_ptr<Data::Local> make_local(const double* all, const Data::Piece& pc) {
+  constexpr int L = Data::local_div;
+  auto loc = std::make_unique<Data::Local>();
+  const std::size_t size = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+  loc->u_nets.resize(L * size);
+  for (int a = 0; a < L; ++a) {
+    double* q = loc->u_nets.data() + a * size;
+    std::copy(all, all + size, q);
+    restrict_dir(q, pc.order, pc.nc, 0, local_lo(a), local_hi(a));
+  }
+  loc->bounds.resize(static_cast<std::size_t>(L * L * L));
+  loc->done = std::make_unique<std::once_flag[]>(static_cast<std::size_t>(L * L * L));
+  return loc;
+}
+
+/// The StepBounds of sub-box (a, b, c) of a piece and its neighbours: of the net restricted to
+/// them along u (kept in `loc`), then v, then w.
+StepBounds local_bounds(const Data::Local& loc, const Data::Piece& pc, int a, int b, int c) {
+  const std::size_t size = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+  const double* qu = loc.u_nets.data() + static_cast<std::size_t>(a) * size;
+  std::vector<double> q(qu, qu + size);
+  restrict_dir(q.data(), pc.order, pc.nc, 1, local_lo(b), local_hi(b));
+  restrict_dir(q.data(), pc.order, pc.nc, 2, local_lo(c), local_hi(c));
   // The fields step_bounds_of reads (not a copy of pc: its lazy members may be being written).
   Data::Piece sub;
   sub.order = pc.order;
   sub.nc = pc.nc;
-  constexpr double S = Data::local_div;
-  for (int c = 0; c < Data::local_div; ++c)
-    for (int b = 0; b < Data::local_div; ++b)
-      for (int a = 0; a < Data::local_div; ++a) {
-        const int idx[3] = {a, b, c};
-        Vec3 lo, hi;
-        for (std::size_t d = 0; d < 3; ++d) {
-          lo[d] = std::max(0.0, (idx[d] - 1) / S);
-          hi[d] = std::min(1.0, (idx[d] + 2) / S);
-          sub.lo[d] = pc.lo[d] + lo[d] * pc.len[d];
-          sub.len[d] = (hi[d] - lo[d]) * pc.len[d];
-          sub.inv_len[d] = 1.0 / sub.len[d];
-        }
-        local[static_cast<std::size_t>(a + Data::local_div * (b + Data::local_div * c))] =
-            step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi).data(), sub);
-      }
-  return local;
+  const int idx[3] = {a, b, c};
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double lo = local_lo(idx[d]), hi = local_hi(idx[d]);
+    sub.lo[d] = pc.lo[d] + lo * pc.len[d];
+    sub.len[d] = (hi - lo) * pc.len[d];
+    sub.inv_len[d] = 1.0 / sub.len[d];
+  }
+  return step_bounds_of(q.data(), sub);
 }
 
 /// A cell's Bezier pieces, before they are built.
@@ -1319,12 +1342,15 @@ const StepBounds& Locator::step_bounds(int piece) const noexcept {
 const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
   const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
   if (!pc.k.all_first || !data_->use_local) return step_bounds(piece);
-  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] { pc.local = local_bounds(data_->pool.data() + pc.net, pc); });
+  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] { pc.local = make_local(data_->pool.data() + pc.net, pc); });
   double s[3];
   Data::local(pc, t, s);
   int idx[3];
   for (int d = 0; d < 3; ++d) idx[d] = std::min(Data::local_div - 1, static_cast<int>(s[d] * Data::local_div));
-  return pc.local[static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]))];
+  const auto k = static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]));
+  Data::Local& loc = *pc.local;
+  std::call_once(loc.done[k], [&] { loc.bounds[k] = local_bounds(loc, pc, idx[0], idx[1], idx[2]); });
+  return loc.bounds[k];
 }
 
 namespace {
