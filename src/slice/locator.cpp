@@ -351,46 +351,65 @@ struct AffineFit {
 };
 
 AffineFit affine_fit(const double* X, const FitTables& T) {
-  AffineFit f;
-  const double n = T.n;
-  if (T.n & (T.n - 1)) {
-    for (int i = 0; i < T.n; ++i)
-      for (std::size_t d = 0; d < 3; ++d) f.mean[d] += X[3 * i + static_cast<int>(d)] / n;
+  // Every sum in local variables, so that the chains of dependent additions stay in registers.
+  const int n = T.n;
+  double m0 = 0.0, m1 = 0.0, m2 = 0.0;
+  if (n & (n - 1)) {
+    const double nd = n;
+    for (int i = 0; i < n; ++i) {
+      m0 += X[3 * i] / nd;
+      m1 += X[3 * i + 1] / nd;
+      m2 += X[3 * i + 2] / nd;
+    }
   } else {  // x / 2^k == x * 2^-k exactly: no divisions (orders 2 and 4)
     const double r = 1.0 / n;
-    for (int i = 0; i < T.n; ++i)
-      for (std::size_t d = 0; d < 3; ++d) f.mean[d] += X[3 * i + static_cast<int>(d)] * r;
+    for (int i = 0; i < n; ++i) {
+      m0 += X[3 * i] * r;
+      m1 += X[3 * i + 1] * r;
+      m2 += X[3 * i + 2] * r;
+    }
   }
-  const auto& x0 = T.xi[0];
-  const auto& x1 = T.xi[1];
-  const auto& x2 = T.xi[2];
-  const std::size_t ou = x0.size(), ov = x1.size(), ow = x2.size();
+  const double* x0 = T.xi[0].data();
+  const double* x1 = T.xi[1].data();
+  const double* x2 = T.xi[2].data();
+  const int ou = T.ord[0], ov = T.ord[1], ow = T.ord[2];
+  double a00 = 0.0, a01 = 0.0, a02 = 0.0, a10 = 0.0, a11 = 0.0, a12 = 0.0, a20 = 0.0, a21 = 0.0, a22 = 0.0;
   const double* p = X;
-  for (std::size_t c = 0; c < ow; ++c)
-    for (std::size_t b = 0; b < ov; ++b)
-      for (std::size_t a = 0; a < ou; ++a, p += 3)
-        for (std::size_t k = 0; k < 3; ++k) {
-          const double e = p[k] - f.mean[k];
-          f.A[0][k] += x0[a] * e;
-          f.A[1][k] += x1[b] * e;
-          f.A[2][k] += x2[c] * e;
-        }
-  for (std::size_t d = 0; d < 3; ++d)
-    if (T.den[d] > 0.0)
-      for (std::size_t k = 0; k < 3; ++k) f.A[d][k] /= T.den[d];
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b)
+      for (int a = 0; a < ou; ++a, p += 3) {
+        const double e0 = p[0] - m0, e1 = p[1] - m1, e2 = p[2] - m2;
+        a00 += x0[a] * e0;
+        a10 += x1[b] * e0;
+        a20 += x2[c] * e0;
+        a01 += x0[a] * e1;
+        a11 += x1[b] * e1;
+        a21 += x2[c] * e1;
+        a02 += x0[a] * e2;
+        a12 += x1[b] * e2;
+        a22 += x2[c] * e2;
+      }
+  if (T.den[0] > 0.0) a00 /= T.den[0], a01 /= T.den[0], a02 /= T.den[0];
+  if (T.den[1] > 0.0) a10 /= T.den[1], a11 /= T.den[1], a12 /= T.den[1];
+  if (T.den[2] > 0.0) a20 /= T.den[2], a21 /= T.den[2], a22 /= T.den[2];
   // The largest squared distance, then one root (the root is monotonic: the same maximum).
   double dev2_max = 0.0;
   p = X;
-  for (std::size_t c = 0; c < ow; ++c)
-    for (std::size_t b = 0; b < ov; ++b)
-      for (std::size_t a = 0; a < ou; ++a, p += 3) {
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b)
+      for (int a = 0; a < ou; ++a, p += 3) {
+        const double e0 = p[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
+        const double e1 = p[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
+        const double e2 = p[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
         double dev2 = 0.0;
-        for (std::size_t k = 0; k < 3; ++k) {
-          const double e = p[k] - f.mean[k] - f.A[0][k] * x0[a] - f.A[1][k] * x1[b] - f.A[2][k] * x2[c];
-          dev2 += e * e;
-        }
+        dev2 += e0 * e0;
+        dev2 += e1 * e1;
+        dev2 += e2 * e2;
         dev2_max = std::max(dev2_max, dev2);
       }
+  AffineFit f;
+  f.mean = {m0, m1, m2};
+  f.A = {Vec3{a00, a01, a02}, Vec3{a10, a11, a12}, Vec3{a20, a21, a22}};
   f.deviation = std::sqrt(dev2_max);
   return f;
 }
