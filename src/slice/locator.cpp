@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -551,6 +552,25 @@ void solve_free(const double J[3][3], const double* r, const bool* free, double*
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+/// A flag for work done once, on first use, by whichever thread comes first: std::call_once
+/// behind an acquire load, since libstdc++'s call_once sets up thread-local state on every call,
+/// even long after the work is done (the sampler asks for bounds at every anchor).
+struct Once {
+  std::atomic<bool> done{false};
+  std::once_flag flag;
+
+  template <class F>
+  void operator()(F&& f) {
+    if (done.load(std::memory_order_acquire)) return;
+    std::call_once(flag, [&] {
+      f();
+      done.store(true, std::memory_order_release);
+    });
+  }
+};
+}  // namespace
+
 struct Locator::Data {
   static constexpr int local_div = 8;
   /// A piece's local bounds: the piece cut into local_div^3 sub-boxes, and for each the bounds
@@ -560,7 +580,7 @@ struct Locator::Data {
   struct Local {
     std::vector<double> u_nets;     ///< the net restricted along u to each u interval
     std::vector<StepBounds> bounds;  ///< per sub-box, u fastest
-    std::unique_ptr<std::once_flag[]> done;  ///< per sub-box: its bounds computed
+    std::unique_ptr<Once[]> done;  ///< per sub-box: its bounds computed
   };
   struct Piece {
     int cell = 0;
@@ -609,8 +629,8 @@ struct Locator::Data {
   bool any_trim = false;
   std::vector<Cell> cells;
   std::vector<Piece> pieces;
-  std::unique_ptr<std::once_flag[]> bounds_once;  ///< one per piece: its bounds computed
-  std::unique_ptr<std::once_flag[]> local_once;   ///< one per piece: its local bounds computed
+  std::unique_ptr<Once[]> bounds_once;  ///< one per piece: its bounds computed
+  std::unique_ptr<Once[]> local_once;   ///< one per piece: its local bounds created
   bool use_local = true;                         ///< false: whole-piece bounds only (memory)
   std::vector<double> pool;  ///< every piece's net, control point after control point
   std::vector<LocatorLeaf> leaves;
@@ -949,7 +969,7 @@ std::unique_ptr<Data::Local> make_local(const double* all, const Data::Piece& pc
     restrict_dir(q, pc.order, pc.nc, 0, local_lo(a), local_hi(a));
   }
   loc->bounds.resize(static_cast<std::size_t>(L * L * L));
-  loc->done = std::make_unique<std::once_flag[]>(static_cast<std::size_t>(L * L * L));
+  loc->done = std::make_unique<Once[]>(static_cast<std::size_t>(L * L * L));
   return loc;
 }
 
@@ -1163,8 +1183,8 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
   for (const auto& l : leaves) D.leaves.insert(D.leaves.end(), l.begin(), l.end());
   for (auto& cp : cells) D.cells.push_back(std::move(cp.cell));
   build_bvh(D);
-  D.bounds_once = std::make_unique<std::once_flag[]>(D.pieces.size());
-  D.local_once = std::make_unique<std::once_flag[]>(D.pieces.size());
+  D.bounds_once = std::make_unique<Once[]>(D.pieces.size());
+  D.local_once = std::make_unique<Once[]>(D.pieces.size());
   // Local bounds cost local_div^3 StepBounds per piece (about 250 kB) and milliseconds to
   // compute: for models of thousands of pieces (finely refined cells) the whole-piece bounds
   // serve instead, a few more anchors against gigabytes and seconds.
@@ -1353,22 +1373,21 @@ bool Locator::expand(int cell, const Vec3& t, Expansion& out) const {
 const StepBounds& Locator::step_bounds(int piece) const noexcept {
   const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
   if (!pc.k.all_first) return pc.bounds;  // not valid
-  std::call_once(data_->bounds_once[static_cast<std::size_t>(piece)],
-                 [&] { pc.bounds = step_bounds_of(data_->pool.data() + pc.net, pc); });
+  data_->bounds_once[static_cast<std::size_t>(piece)]([&] { pc.bounds = step_bounds_of(data_->pool.data() + pc.net, pc); });
   return pc.bounds;
 }
 
 const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
   const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
   if (!pc.k.all_first || !data_->use_local) return step_bounds(piece);
-  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] { pc.local = make_local(data_->pool.data() + pc.net, pc); });
+  data_->local_once[static_cast<std::size_t>(piece)]([&] { pc.local = make_local(data_->pool.data() + pc.net, pc); });
   double s[3];
   Data::local(pc, t, s);
   int idx[3];
   for (int d = 0; d < 3; ++d) idx[d] = std::min(Data::local_div - 1, static_cast<int>(s[d] * Data::local_div));
   const auto k = static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]));
   Data::Local& loc = *pc.local;
-  std::call_once(loc.done[k], [&] { loc.bounds[k] = local_bounds(loc, pc, idx[0], idx[1], idx[2]); });
+  loc.done[k]([&] { loc.bounds[k] = local_bounds(loc, pc, idx[0], idx[1], idx[2]); });
   return loc.bounds[k];
 }
 
