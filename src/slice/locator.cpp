@@ -2,6 +2,10 @@
 
 #include <tbb/parallel_for.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -273,7 +277,7 @@ void restrict_dir(double* q, const std::array<int, 3>& ord, int H, int d, double
 
 /// Both halves of a net split at the middle of direction d, from one de Casteljau triangle per
 /// line: the same values as restrict_line to [0, 1/2] and to [1/2, 1] (each step 0.5 x + 0.5 y,
-/// x the point of lower index), at half the work and without copies.
+/// x the point of lower index), at half the work of the two restrictions.
 /// @param P     the net: H coordinates per point, u fastest, orders ord
 /// @param L, R  the halves (as many values as P), written
 void split_half(const double* P, const std::array<int, 3>& ord, int H, int d, double* L, double* R) {
@@ -376,6 +380,34 @@ AffineFit affine_fit(const double* X, const FitTables& T) {
   const int ou = T.ord[0], ov = T.ord[1], ow = T.ord[2];
   double a00 = 0.0, a01 = 0.0, a02 = 0.0, a10 = 0.0, a11 = 0.0, a12 = 0.0, a20 = 0.0, a21 = 0.0, a22 = 0.0;
   const double* p = X;
+#if defined(__SSE2__)
+  {
+    // The x and y slopes of each direction in the lanes of one register: the same sums.
+    const __m128d vm01 = _mm_set_pd(m1, m0);
+    __m128d s0 = _mm_setzero_pd(), s1 = _mm_setzero_pd(), s2 = _mm_setzero_pd();  // (a_d0, a_d1)
+    for (int c = 0; c < ow; ++c)
+      for (int b = 0; b < ov; ++b) {
+        const __m128d y1 = _mm_set1_pd(x1[b]), y2 = _mm_set1_pd(x2[c]);
+        for (int a = 0; a < ou; ++a, p += 3) {
+          const __m128d e01 = _mm_sub_pd(_mm_loadu_pd(p), vm01);
+          const double e2 = p[2] - m2;
+          s0 = _mm_add_pd(s0, _mm_mul_pd(_mm_set1_pd(x0[a]), e01));
+          s1 = _mm_add_pd(s1, _mm_mul_pd(y1, e01));
+          s2 = _mm_add_pd(s2, _mm_mul_pd(y2, e01));
+          a02 += x0[a] * e2;
+          a12 += x1[b] * e2;
+          a22 += x2[c] * e2;
+        }
+      }
+    double l[2];
+    _mm_storeu_pd(l, s0);
+    a00 = l[0], a01 = l[1];
+    _mm_storeu_pd(l, s1);
+    a10 = l[0], a11 = l[1];
+    _mm_storeu_pd(l, s2);
+    a20 = l[0], a21 = l[1];
+  }
+#else
   for (int c = 0; c < ow; ++c)
     for (int b = 0; b < ov; ++b)
       for (int a = 0; a < ou; ++a, p += 3) {
@@ -390,12 +422,51 @@ AffineFit affine_fit(const double* X, const FitTables& T) {
         a12 += x1[b] * e2;
         a22 += x2[c] * e2;
       }
+#endif
   if (T.den[0] > 0.0) a00 /= T.den[0], a01 /= T.den[0], a02 /= T.den[0];
   if (T.den[1] > 0.0) a10 /= T.den[1], a11 /= T.den[1], a12 /= T.den[1];
   if (T.den[2] > 0.0) a20 /= T.den[2], a21 /= T.den[2], a22 /= T.den[2];
   // The largest squared distance, then one root (the root is monotonic: the same maximum).
   double dev2_max = 0.0;
   p = X;
+#if defined(__SSE2__)
+  // Two points at a time along u, one per lane: the same operations per point. Lanes keep
+  // their own maxima (neither takes a NaN: maxpd returns its second operand then, as std::max).
+  const __m128d vm0 = _mm_set1_pd(m0), vm1 = _mm_set1_pd(m1), vm2 = _mm_set1_pd(m2);
+  const __m128d v00 = _mm_set1_pd(a00), v10 = _mm_set1_pd(a10), v20 = _mm_set1_pd(a20);
+  const __m128d v01 = _mm_set1_pd(a01), v11 = _mm_set1_pd(a11), v21 = _mm_set1_pd(a21);
+  const __m128d v02 = _mm_set1_pd(a02), v12 = _mm_set1_pd(a12), v22 = _mm_set1_pd(a22);
+  __m128d vmax = _mm_setzero_pd();
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b) {
+      const __m128d y1 = _mm_set1_pd(x1[b]), y2 = _mm_set1_pd(x2[c]);
+      int a = 0;
+      for (; a + 1 < ou; a += 2, p += 6) {
+        const __m128d q01 = _mm_loadu_pd(p), q23 = _mm_loadu_pd(p + 2), q45 = _mm_loadu_pd(p + 4);
+        const __m128d X0 = _mm_shuffle_pd(q01, q23, 2), X1 = _mm_shuffle_pd(q01, q45, 1), X2 = _mm_shuffle_pd(q23, q45, 2);
+        const __m128d y0 = _mm_loadu_pd(x0 + a);
+        const __m128d e0 = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(_mm_sub_pd(X0, vm0), _mm_mul_pd(v00, y0)), _mm_mul_pd(v10, y1)), _mm_mul_pd(v20, y2));
+        const __m128d e1 = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(_mm_sub_pd(X1, vm1), _mm_mul_pd(v01, y0)), _mm_mul_pd(v11, y1)), _mm_mul_pd(v21, y2));
+        const __m128d e2 = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(_mm_sub_pd(X2, vm2), _mm_mul_pd(v02, y0)), _mm_mul_pd(v12, y1)), _mm_mul_pd(v22, y2));
+        // 0 + e0^2 == e0^2 exactly (a square is +0 or more, or NaN): the sum from its first term.
+        const __m128d dev2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(e0, e0), _mm_mul_pd(e1, e1)), _mm_mul_pd(e2, e2));
+        vmax = _mm_max_pd(dev2, vmax);
+      }
+      for (; a < ou; ++a, p += 3) {
+        const double e0 = p[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
+        const double e1 = p[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
+        const double e2 = p[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
+        double dev2 = 0.0;
+        dev2 += e0 * e0;
+        dev2 += e1 * e1;
+        dev2 += e2 * e2;
+        dev2_max = std::max(dev2_max, dev2);
+      }
+    }
+  double lanes[2];
+  _mm_storeu_pd(lanes, vmax);
+  dev2_max = std::max(dev2_max, std::max(lanes[0], lanes[1]));
+#else
   for (int c = 0; c < ow; ++c)
     for (int b = 0; b < ov; ++b)
       for (int a = 0; a < ou; ++a, p += 3) {
@@ -408,6 +479,7 @@ AffineFit affine_fit(const double* X, const FitTables& T) {
         dev2 += e2 * e2;
         dev2_max = std::max(dev2_max, dev2);
       }
+#endif
   AffineFit f;
   f.mean = {m0, m1, m2};
   f.A = {Vec3{a00, a01, a02}, Vec3{a10, a11, a12}, Vec3{a20, a21, a22}};
