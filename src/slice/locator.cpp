@@ -2,7 +2,12 @@
 
 #include <tbb/parallel_for.h>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -260,25 +265,58 @@ void restrict_line(double* P, int n, int stride, int H, double a, double b) {
         for (int h = 0; h < H; ++h) at(i)[h] = (1.0 - t) * at(i)[h] + t * at(i + 1)[h];
 }
 
-/// The net (H coordinates per point, u fastest) restricted to the local box [lo, hi].
-std::vector<double> restrict_net(const std::vector<double>& net, const std::array<int, 3>& ord, int H, const Vec3& lo,
-                                 const Vec3& hi) {
-  std::vector<double> q = net;
+/// Restricts direction d of a net (H coordinates per point, u fastest, orders ord) to the local
+/// interval [a, b], in place: restrict_line on every line along d.
+void restrict_dir(double* q, const std::array<int, 3>& ord, int H, int d, double a, double b) {
   const int ou = ord[0], ov = ord[1], ow = ord[2];
-  for (int c = 0; c < ow; ++c)
-    for (int b = 0; b < ov; ++b) restrict_line(q.data() + (c * ov + b) * ou * H, ou, H, H, lo[0], hi[0]);
-  for (int c = 0; c < ow; ++c)
-    for (int a = 0; a < ou; ++a) restrict_line(q.data() + (c * ov * ou + a) * H, ov, ou * H, H, lo[1], hi[1]);
-  for (int b = 0; b < ov; ++b)
-    for (int a = 0; a < ou; ++a) restrict_line(q.data() + (b * ou + a) * H, ow, ou * ov * H, H, lo[2], hi[2]);
-  return q;
+  if (d == 0)
+    for (int c = 0; c < ow; ++c)
+      for (int j = 0; j < ov; ++j) restrict_line(q + (c * ov + j) * ou * H, ou, H, H, a, b);
+  else if (d == 1)
+    for (int c = 0; c < ow; ++c)
+      for (int i = 0; i < ou; ++i) restrict_line(q + (c * ov * ou + i) * H, ov, ou * H, H, a, b);
+  else
+    for (int j = 0; j < ov; ++j)
+      for (int i = 0; i < ou; ++i) restrict_line(q + (j * ou + i) * H, ow, ou * ov * H, H, a, b);
 }
 
-/// Cartesian xyz of control point i of a geometry net.
-inline Vec3 cartesian(const double* net, int i, int H) {
-  const double* q = net + static_cast<std::ptrdiff_t>(i) * H;
-  const double w = H == 4 ? q[3] : 1.0;
-  return {q[0] / w, q[1] / w, q[2] / w};
+/// Both halves of a net split at the middle of direction d, from one de Casteljau triangle per
+/// line: the same values as restrict_line to [0, 1/2] and to [1/2, 1] (each step 0.5 x + 0.5 y,
+/// x the point of lower index), at half the work of the two restrictions.
+/// @param P     the net: H coordinates per point, u fastest, orders ord
+/// @param L, R  the halves (as many values as P), written
+void split_half(const double* P, const std::array<int, 3>& ord, int H, int d, double* L, double* R) {
+  // Along d the net is `outer` blocks of n rows of `inner` contiguous values.
+  const int n = ord[static_cast<std::size_t>(d)];
+  const int inner = H * (d == 0 ? 1 : d == 1 ? ord[0] : ord[0] * ord[1]);
+  const int outer = d == 0 ? ord[1] * ord[2] : d == 1 ? ord[2] : 1;
+  const std::ptrdiff_t block = static_cast<std::ptrdiff_t>(n) * inner;
+  for (int o = 0; o < outer; ++o) {
+    const double* p = P + o * block;
+    double* l = L + o * block;
+    double* r = R + o * block;  // the triangle's working rows; row i ends as the right half's
+    std::copy(p, p + inner, l);
+    if (n == 1) std::copy(p, p + inner, r);
+    for (int k = 1; k < n; ++k) {
+      if (k == 1) {  // the first stage reads P
+        for (int j = 0; j < n - 1; ++j) {
+          const double* pj = p + static_cast<std::ptrdiff_t>(j) * inner;
+          const double* pj1 = pj + inner;
+          double* rj = r + static_cast<std::ptrdiff_t>(j) * inner;
+          for (int e = 0; e < inner; ++e) rj[e] = 0.5 * pj[e] + 0.5 * pj1[e];
+        }
+        std::copy(p + block - inner, p + block, r + block - inner);
+        std::copy(r, r + inner, l + inner);
+        continue;
+      }
+      for (int j = 0; j < n - k; ++j) {
+        double* rj = r + static_cast<std::ptrdiff_t>(j) * inner;
+        const double* rj1 = rj + inner;
+        for (int e = 0; e < inner; ++e) rj[e] = 0.5 * rj[e] + 0.5 * rj1[e];
+      }
+      std::copy(r, r + inner, l + static_cast<std::ptrdiff_t>(k) * inner);
+    }
+  }
 }
 
 struct Flatness {
@@ -290,50 +328,189 @@ struct Flatness {
   std::array<Vec3, 3> frame{};  ///< rows of the inverse of the affine map's matrix
 };
 
-/// How far a net is from an affine map of its parameters (control points against their Greville
-/// abscissae i / (order - 1), a tensor grid, so the least-squares fit separates per direction),
-/// and the boxes that hold it.
-Flatness flatness(const std::vector<double>& net, const std::array<int, 3>& ord, int H) {
-  const std::size_t n = static_cast<std::size_t>(ord[0] * ord[1] * ord[2]);
-  Flatness f;
+/// What the least-squares affine fit of nets of one order needs beyond the net: the control
+/// points' Greville abscissae i / (order - 1), centred, per direction (a tensor grid, so the fit
+/// separates per direction), and their squared sums over the grid. One per piece.
+struct FitTables {
+  std::array<int, 3> ord{};
+  int n = 0;
+  std::array<std::vector<double>, 3> xi;
+  Vec3 den{};
+
+  explicit FitTables(const std::array<int, 3>& o) : ord(o), n(o[0] * o[1] * o[2]) {
+    for (std::size_t d = 0; d < 3; ++d) {
+      xi[d].resize(static_cast<std::size_t>(o[d]));
+      for (int j = 0; j < o[d]; ++j) xi[d][static_cast<std::size_t>(j)] = o[d] > 1 ? double(j) / (o[d] - 1) - 0.5 : 0.0;
+    }
+    // Summed over the grid point after point (u fastest), as the fit sums.
+    for (int c = 0; c < o[2]; ++c)
+      for (int b = 0; b < o[1]; ++b)
+        for (int a = 0; a < o[0]; ++a) {
+          const double x[3] = {xi[0][static_cast<std::size_t>(a)], xi[1][static_cast<std::size_t>(b)], xi[2][static_cast<std::size_t>(c)]};
+          for (std::size_t d = 0; d < 3; ++d) den[d] += x[d] * x[d];
+        }
+  }
+};
+
+/// The least-squares affine map of a net's control points X (xyz, 3 per point) against their
+/// Greville abscissae: X ~ mean + sum_d A[d] xi_d, and the largest distance of a point from it.
+struct AffineFit {
+  Vec3 mean{};
+  std::array<Vec3, 3> A{};  ///< A[d]: the xyz change per unit of direction d
+  double deviation = 0.0;
+};
+
+AffineFit affine_fit(const double* X, const FitTables& T) {
+  // Every sum in local variables, so that the chains of dependent additions stay in registers.
+  const int n = T.n;
+  double m0 = 0.0, m1 = 0.0, m2 = 0.0;
+  if (n & (n - 1)) {
+    const double nd = n;
+    for (int i = 0; i < n; ++i) {
+      m0 += X[3 * i] / nd;
+      m1 += X[3 * i + 1] / nd;
+      m2 += X[3 * i + 2] / nd;
+    }
+  } else {  // x / 2^k == x * 2^-k exactly: no divisions (orders 2 and 4)
+    const double r = 1.0 / n;
+    for (int i = 0; i < n; ++i) {
+      m0 += X[3 * i] * r;
+      m1 += X[3 * i + 1] * r;
+      m2 += X[3 * i + 2] * r;
+    }
+  }
+  const double* x0 = T.xi[0].data();
+  const double* x1 = T.xi[1].data();
+  const double* x2 = T.xi[2].data();
+  const int ou = T.ord[0], ov = T.ord[1], ow = T.ord[2];
+  double a00 = 0.0, a01 = 0.0, a02 = 0.0, a10 = 0.0, a11 = 0.0, a12 = 0.0, a20 = 0.0, a21 = 0.0, a22 = 0.0;
+  const double* p = X;
+#if defined(__SSE2__)
+  {
+    // The x and y slopes of each direction in the lanes of one register: the same sums.
+    const __m128d vm01 = _mm_set_pd(m1, m0);
+    __m128d s0 = _mm_setzero_pd(), s1 = _mm_setzero_pd(), s2 = _mm_setzero_pd();  // (a_d0, a_d1)
+    for (int c = 0; c < ow; ++c)
+      for (int b = 0; b < ov; ++b) {
+        const __m128d y1 = _mm_set1_pd(x1[b]), y2 = _mm_set1_pd(x2[c]);
+        for (int a = 0; a < ou; ++a, p += 3) {
+          const __m128d e01 = _mm_sub_pd(_mm_loadu_pd(p), vm01);
+          const double e2 = p[2] - m2;
+          s0 = _mm_add_pd(s0, _mm_mul_pd(_mm_set1_pd(x0[a]), e01));
+          s1 = _mm_add_pd(s1, _mm_mul_pd(y1, e01));
+          s2 = _mm_add_pd(s2, _mm_mul_pd(y2, e01));
+          a02 += x0[a] * e2;
+          a12 += x1[b] * e2;
+          a22 += x2[c] * e2;
+        }
+      }
+    double l[2];
+    _mm_storeu_pd(l, s0);
+    a00 = l[0], a01 = l[1];
+    _mm_storeu_pd(l, s1);
+    a10 = l[0], a11 = l[1];
+    _mm_storeu_pd(l, s2);
+    a20 = l[0], a21 = l[1];
+  }
+#else
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b)
+      for (int a = 0; a < ou; ++a, p += 3) {
+        const double e0 = p[0] - m0, e1 = p[1] - m1, e2 = p[2] - m2;
+        a00 += x0[a] * e0;
+        a10 += x1[b] * e0;
+        a20 += x2[c] * e0;
+        a01 += x0[a] * e1;
+        a11 += x1[b] * e1;
+        a21 += x2[c] * e1;
+        a02 += x0[a] * e2;
+        a12 += x1[b] * e2;
+        a22 += x2[c] * e2;
+      }
+#endif
+  if (T.den[0] > 0.0) a00 /= T.den[0], a01 /= T.den[0], a02 /= T.den[0];
+  if (T.den[1] > 0.0) a10 /= T.den[1], a11 /= T.den[1], a12 /= T.den[1];
+  if (T.den[2] > 0.0) a20 /= T.den[2], a21 /= T.den[2], a22 /= T.den[2];
+  // The largest squared distance, then one root (the root is monotonic: the same maximum).
+  double dev2_max = 0.0;
+  p = X;
+#if defined(__SSE2__)
+  // Two points at a time along u, one per lane: the same operations per point. Lanes keep
+  // their own maxima (neither takes a NaN: maxpd returns its second operand then, as std::max).
+  const __m128d vm0 = _mm_set1_pd(m0), vm1 = _mm_set1_pd(m1), vm2 = _mm_set1_pd(m2);
+  const __m128d v00 = _mm_set1_pd(a00), v10 = _mm_set1_pd(a10), v20 = _mm_set1_pd(a20);
+  const __m128d v01 = _mm_set1_pd(a01), v11 = _mm_set1_pd(a11), v21 = _mm_set1_pd(a21);
+  const __m128d v02 = _mm_set1_pd(a02), v12 = _mm_set1_pd(a12), v22 = _mm_set1_pd(a22);
+  __m128d vmax = _mm_setzero_pd();
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b) {
+      const __m128d y1 = _mm_set1_pd(x1[b]), y2 = _mm_set1_pd(x2[c]);
+      int a = 0;
+      for (; a + 1 < ou; a += 2, p += 6) {
+        const __m128d q01 = _mm_loadu_pd(p), q23 = _mm_loadu_pd(p + 2), q45 = _mm_loadu_pd(p + 4);
+        const __m128d X0 = _mm_shuffle_pd(q01, q23, 2), X1 = _mm_shuffle_pd(q01, q45, 1), X2 = _mm_shuffle_pd(q23, q45, 2);
+        const __m128d y0 = _mm_loadu_pd(x0 + a);
+        const __m128d e0 = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(_mm_sub_pd(X0, vm0), _mm_mul_pd(v00, y0)), _mm_mul_pd(v10, y1)), _mm_mul_pd(v20, y2));
+        const __m128d e1 = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(_mm_sub_pd(X1, vm1), _mm_mul_pd(v01, y0)), _mm_mul_pd(v11, y1)), _mm_mul_pd(v21, y2));
+        const __m128d e2 = _mm_sub_pd(_mm_sub_pd(_mm_sub_pd(_mm_sub_pd(X2, vm2), _mm_mul_pd(v02, y0)), _mm_mul_pd(v12, y1)), _mm_mul_pd(v22, y2));
+        // 0 + e0^2 == e0^2 exactly (a square is +0 or more, or NaN): the sum from its first term.
+        const __m128d dev2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(e0, e0), _mm_mul_pd(e1, e1)), _mm_mul_pd(e2, e2));
+        vmax = _mm_max_pd(dev2, vmax);
+      }
+      for (; a < ou; ++a, p += 3) {
+        const double e0 = p[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
+        const double e1 = p[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
+        const double e2 = p[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
+        double dev2 = 0.0;
+        dev2 += e0 * e0;
+        dev2 += e1 * e1;
+        dev2 += e2 * e2;
+        dev2_max = std::max(dev2_max, dev2);
+      }
+    }
+  double lanes[2];
+  _mm_storeu_pd(lanes, vmax);
+  dev2_max = std::max(dev2_max, std::max(lanes[0], lanes[1]));
+#else
+  for (int c = 0; c < ow; ++c)
+    for (int b = 0; b < ov; ++b)
+      for (int a = 0; a < ou; ++a, p += 3) {
+        const double e0 = p[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
+        const double e1 = p[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
+        const double e2 = p[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
+        double dev2 = 0.0;
+        dev2 += e0 * e0;
+        dev2 += e1 * e1;
+        dev2 += e2 * e2;
+        dev2_max = std::max(dev2_max, dev2);
+      }
+#endif
+  AffineFit f;
+  f.mean = {m0, m1, m2};
+  f.A = {Vec3{a00, a01, a02}, Vec3{a10, a11, a12}, Vec3{a20, a21, a22}};
+  f.deviation = std::sqrt(dev2_max);
+  return f;
+}
+
+/// The control points' xyz box and its diagonal.
+void control_box(const double* X, int n, Flatness& f) {
   f.box_lo = {inf, inf, inf};
   f.box_hi = {-inf, -inf, -inf};
-  std::vector<Vec3> X(n);
-  std::vector<std::array<double, 3>> xi(n);  // Greville abscissae, centred
-  Vec3 mean{};
-  for (std::size_t i = 0; i < n; ++i) {
-    X[i] = cartesian(net.data(), static_cast<int>(i), H);
-    const int idx[3] = {static_cast<int>(i) % ord[0], (static_cast<int>(i) / ord[0]) % ord[1], static_cast<int>(i) / (ord[0] * ord[1])};
+  for (int i = 0; i < n; ++i)
     for (std::size_t d = 0; d < 3; ++d) {
-      xi[i][d] = ord[d] > 1 ? double(idx[d]) / (ord[d] - 1) - 0.5 : 0.0;
-      mean[d] += X[i][d] / static_cast<double>(n);
-      f.box_lo[d] = std::min(f.box_lo[d], X[i][d]);
-      f.box_hi[d] = std::max(f.box_hi[d], X[i][d]);
+      f.box_lo[d] = std::min(f.box_lo[d], X[3 * i + static_cast<int>(d)]);
+      f.box_hi[d] = std::max(f.box_hi[d], X[3 * i + static_cast<int>(d)]);
     }
-  }
-  std::array<Vec3, 3> A{};  // A[d]: the xyz change per unit of direction d
-  for (std::size_t d = 0; d < 3; ++d) {
-    double den = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      den += xi[i][d] * xi[i][d];
-      for (std::size_t k = 0; k < 3; ++k) A[d][k] += xi[i][d] * (X[i][k] - mean[k]);
-    }
-    if (den > 0.0)
-      for (std::size_t k = 0; k < 3; ++k) A[d][k] /= den;
-  }
   double diag2 = 0.0;
   for (std::size_t d = 0; d < 3; ++d) diag2 += (f.box_hi[d] - f.box_lo[d]) * (f.box_hi[d] - f.box_lo[d]);
   f.diagonal = std::sqrt(diag2);
-  for (std::size_t i = 0; i < n; ++i) {
-    double dev2 = 0.0;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double e = X[i][k] - mean[k] - A[0][k] * xi[i][0] - A[1][k] * xi[i][1] - A[2][k] * xi[i][2];
-      dev2 += e * e;
-    }
-    f.deviation = std::max(f.deviation, std::sqrt(dev2));
-  }
-  // Frame: the inverse of [A0 A1 A2] (rows = cross products / det), or the identity when the
-  // affine map is (nearly) degenerate.
+}
+
+/// The parallelepiped of the fit's frame that holds the control points X: the frame is the
+/// inverse of [A0 A1 A2] (rows = cross products / det), or the identity when the affine map is
+/// (nearly) degenerate.
+void fit_frame(const double* X, int n, const AffineFit& fit, Flatness& f) {
+  const auto& A = fit.A;
   auto cross = [](const Vec3& a, const Vec3& b) { return Vec3{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; };
   auto len = [](const Vec3& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); };
   const Vec3 c0 = cross(A[1], A[2]), c1 = cross(A[2], A[0]), c2 = cross(A[0], A[1]);
@@ -347,16 +524,29 @@ Flatness flatness(const std::vector<double>& net, const std::array<int, 3>& ord,
   } else {
     f.frame = {Vec3{1, 0, 0}, Vec3{0, 1, 0}, Vec3{0, 0, 1}};
   }
+  const Vec3& mean = fit.mean;
   f.origin = mean;
   f.frame_lo = {inf, inf, inf};
   f.frame_hi = {-inf, -inf, -inf};
-  for (std::size_t i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
+    const double* x = X + 3 * i;
     for (std::size_t k = 0; k < 3; ++k) {
-      const double c = f.frame[k][0] * (X[i][0] - mean[0]) + f.frame[k][1] * (X[i][1] - mean[1]) + f.frame[k][2] * (X[i][2] - mean[2]);
+      const double c = f.frame[k][0] * (x[0] - mean[0]) + f.frame[k][1] * (x[1] - mean[1]) + f.frame[k][2] * (x[2] - mean[2]);
       f.frame_lo[k] = std::min(f.frame_lo[k], c);
       f.frame_hi[k] = std::max(f.frame_hi[k], c);
     }
-  return f;
+  }
+}
+
+/// The xyz of a geometry net's control points (3 per point): the net itself when polynomial
+/// (H = 3), else into `buf` (n * 3 values) divided by the weights.
+const double* cartesian_points(const double* net, int n, int H, double* buf) {
+  if (H == 3) return net;
+  for (int i = 0; i < n; ++i) {
+    const double* q = net + 4 * i;
+    for (int k = 0; k < 3; ++k) buf[3 * i + k] = q[k] / q[3];
+  }
+  return buf;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -439,7 +629,36 @@ void solve_free(const double J[3][3], const double* r, const bool* free, double*
 
 // ---------------------------------------------------------------------------------------------
 
+namespace {
+/// A flag for work done once, on first use, by whichever thread comes first: std::call_once
+/// behind an acquire load, since libstdc++'s call_once sets up thread-local state on every call,
+/// even long after the work is done (the sampler asks for bounds at every anchor).
+struct Once {
+  std::atomic<bool> done{false};
+  std::once_flag flag;
+
+  template <class F>
+  void operator()(F&& f) {
+    if (done.load(std::memory_order_acquire)) return;
+    std::call_once(flag, [&] {
+      f();
+      done.store(true, std::memory_order_release);
+    });
+  }
+};
+}  // namespace
+
 struct Locator::Data {
+  static constexpr int local_div = 8;
+  /// A piece's local bounds: the piece cut into local_div^3 sub-boxes, and for each the bounds
+  /// over it and its neighbours (up to 3 x 3 x 3 sub-boxes), each computed on first use under
+  /// its flag (a thin job meets only a few sub-boxes of a piece). The sub-box's net is the
+  /// piece's restricted along u, then v, then w; the local_div u restrictions are kept.
+  struct Local {
+    std::vector<double> u_nets;     ///< the net restricted along u to each u interval
+    std::vector<StepBounds> bounds;  ///< per sub-box, u fastest
+    std::unique_ptr<Once[]> done;  ///< per sub-box: its bounds computed
+  };
   struct Piece {
     int cell = 0;
     std::array<int, 3> order{};
@@ -449,12 +668,13 @@ struct Locator::Data {
     Kernels k;
     std::size_t net = 0;  ///< offset into the pool
     Vec3 lipschitz{};     ///< bounds on |dX/dt_d| (global parameters); inf if rational
-    StepBounds bounds;    ///< second-derivative bounds (polynomial pieces with all_first)
-    /// Tighter bounds near a point: the piece cut into local_div^3 sub-boxes, and for each the
-    /// bounds over it and its neighbours (up to 3 x 3 x 3 sub-boxes); empty without `bounds`.
-    mutable std::vector<StepBounds> local;  ///< filled on first use, under local_once
+    /// Second-derivative bounds (polynomial pieces with all_first): computed on first use,
+    /// under bounds_once (a job touches only some pieces; the values do not depend on which
+    /// thread computes them).
+    mutable StepBounds bounds;
+    /// Tighter bounds near a point (see Local): created on first use, under local_once.
+    mutable std::unique_ptr<Local> local;
   };
-  static constexpr int local_div = 8;
   struct Cell {
     std::array<std::vector<double>, 3> breaks;  ///< distinct knots inside the domain
     std::array<int, 3> spans{};
@@ -486,7 +706,8 @@ struct Locator::Data {
   bool any_trim = false;
   std::vector<Cell> cells;
   std::vector<Piece> pieces;
-  std::unique_ptr<std::once_flag[]> local_once;  ///< one per piece: its local bounds computed
+  std::unique_ptr<Once[]> bounds_once;  ///< one per piece: its bounds computed
+  std::unique_ptr<Once[]> local_once;   ///< one per piece: its local bounds created
   bool use_local = true;                         ///< false: whole-piece bounds only (memory)
   std::vector<double> pool;  ///< every piece's net, control point after control point
   std::vector<LocatorLeaf> leaves;
@@ -568,77 +789,126 @@ namespace {
 
 using Data = Locator::Data;
 
-struct CellBuild {
-  Data::Cell cell;
-  std::vector<Data::Piece> pieces;
-  std::vector<std::vector<double>> nets;
-  std::vector<LocatorLeaf> leaves;  // piece = local index until merged
+/// A leaf of build_leaves: its box in the piece's local [0,1]^3 and its regions.
+struct LeafBox {
+  Vec3 lo, hi;
+  Flatness f;
 };
 
 /// Subdivides a piece's parameter box (local [0,1]^3) into nearly affine leaves: deviation from
 /// affine at most 10% of the leaf's diagonal and, when `max_dev` > 0, at most max_dev; then, when
 /// 0 < fine_dev < max_dev, on towards fine_dev with at most fine_factor times as many leaves
 /// (the most deviating split first, so a budget that runs out leaves the piece evenly refined).
-void build_leaves(const std::vector<double>& net, const std::array<int, 3>& ord, int H, double min_diag, double max_dev,
-                  double fine_dev, int fine_factor, int max_leaves, std::vector<std::pair<std::array<Vec3, 2>, Flatness>>& out) {
+/// Cost per split: one de Casteljau triangle and one or two affine fits per direction tried; the
+/// frames only for the leaves. Nets live in one slab of reused slots (no allocation per split).
+/// @param net  the piece's geometry net: H coordinates per control point, u fastest
+void build_leaves(const double* net, const std::array<int, 3>& ord, int H, double min_diag, double max_dev, double fine_dev,
+                  int fine_factor, int max_leaves, std::vector<LeafBox>& out) {
   constexpr double flat = 0.1;  // deviation / diagonal at which a leaf is flat enough
+  const FitTables T(ord);
+  const int n = T.n;
+  const std::size_t size = static_cast<std::size_t>(n) * static_cast<std::size_t>(H);
   struct Item {
     Vec3 lo, hi;
-    std::vector<double> net;
-    Flatness f;
+    int slot;  // its net in the slab
+    AffineFit fit;
+    Flatness f;  // deviation, diagonal and box; the frame is filled for the leaves at the end
   };
-  auto less = [](const Item& a, const Item& b) { return a.f.deviation < b.f.deviation; };
-  std::vector<Item> work, done;
+  std::vector<double> slab;
+  std::vector<int> free_slots;
+  auto take = [&] {
+    if (!free_slots.empty()) {
+      const int s = free_slots.back();
+      free_slots.pop_back();
+      return s;
+    }
+    const int s = static_cast<int>(slab.size() / size);
+    slab.resize(slab.size() + size);
+    return s;
+  };
+  auto at = [&](int slot) { return slab.data() + static_cast<std::ptrdiff_t>(slot) * static_cast<std::ptrdiff_t>(size); };
+  std::vector<double> xyz(H == 3 ? 0 : static_cast<std::size_t>(n) * 3);  // cartesian points of rational nets
+  auto points = [&](int slot) { return cartesian_points(at(slot), n, H, xyz.data()); };
+
+  // The heap and the lists hold small records (deviation, item); the items stay in place.
+  struct Ref {
+    double deviation;
+    int item;
+  };
+  auto less = [](const Ref& a, const Ref& b) { return a.deviation < b.deviation; };
+  std::vector<Item> items;
+  std::vector<Ref> work, done;
   // Splits the most deviating item until every one is flat enough for dev_limit or the budget
   // of `cap` leaves is spent.
   auto refine = [&](double dev_limit, int cap) {
     while (!work.empty()) {
       std::pop_heap(work.begin(), work.end(), less);
-      Item it = std::move(work.back());
+      const Ref ref = work.back();
       work.pop_back();
+      const Item& it = items[static_cast<std::size_t>(ref.item)];
       const bool flat_enough = it.f.deviation <= flat * it.f.diagonal && (dev_limit <= 0.0 || it.f.deviation <= dev_limit);
       const bool stop = flat_enough || it.f.diagonal < min_diag || static_cast<int>(done.size() + work.size()) + 2 > cap;
       if (stop) {
-        done.push_back(std::move(it));
+        done.push_back(ref);
         continue;
       }
       // Split the direction whose halves come out flattest (absolute deviation: splitting a
-      // direction along which the net is already straight leaves the deviation as it is).
+      // direction along which the net is already straight leaves the deviation as it is). A
+      // direction whose first half already deviates as much as the best so far cannot win.
       int best = -1;
       double best_dev = inf;
+      int best_slots[2] = {take(), take()}, try_slots[2] = {take(), take()};
+      AffineFit best_fit[2], try_fit[2];
       for (int d = 0; d < 3; ++d) {
         if (ord[static_cast<std::size_t>(d)] < 2) continue;
+        split_half(at(it.slot), ord, H, d, at(try_slots[0]), at(try_slots[1]));
         double dev = 0.0;
-        for (int side = 0; side < 2; ++side) {
-          Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
-          (side ? lo : hi)[static_cast<std::size_t>(d)] = 0.5;
-          dev = std::max(dev, flatness(restrict_net(it.net, ord, H, lo, hi), ord, H).deviation);
+        for (int side = 0; side < 2 && dev < best_dev; ++side) {
+          try_fit[side] = affine_fit(points(try_slots[side]), T);
+          dev = std::max(dev, try_fit[side].deviation);
         }
         if (dev < best_dev) {
           best_dev = dev;
           best = d;
+          std::swap(best_slots, try_slots);
+          std::swap(best_fit, try_fit);
         }
       }
+      free_slots.push_back(try_slots[0]);
+      free_slots.push_back(try_slots[1]);
       if (best < 0) {
-        done.push_back(std::move(it));
+        free_slots.push_back(best_slots[0]);
+        free_slots.push_back(best_slots[1]);
+        done.push_back(ref);
         continue;
       }
+      free_slots.push_back(it.slot);
+      const Vec3 lo = it.lo, hi = it.hi;  // `it` dies when items grows
       for (int side = 0; side < 2; ++side) {
-        Vec3 lo = {0, 0, 0}, hi = {1, 1, 1};
-        (side ? lo : hi)[static_cast<std::size_t>(best)] = 0.5;
         Item child;
-        child.net = restrict_net(it.net, ord, H, lo, hi);
-        child.f = flatness(child.net, ord, H);
-        child.lo = it.lo;
-        child.hi = it.hi;
-        const double mid = 0.5 * (it.lo[static_cast<std::size_t>(best)] + it.hi[static_cast<std::size_t>(best)]);
+        child.slot = best_slots[side];
+        child.fit = best_fit[side];
+        child.f.deviation = child.fit.deviation;
+        control_box(points(child.slot), n, child.f);
+        child.lo = lo;
+        child.hi = hi;
+        const double mid = 0.5 * (lo[static_cast<std::size_t>(best)] + hi[static_cast<std::size_t>(best)]);
         (side ? child.lo : child.hi)[static_cast<std::size_t>(best)] = mid;
-        work.push_back(std::move(child));
+        items.push_back(child);
+        work.push_back({child.f.deviation, static_cast<int>(items.size()) - 1});
         std::push_heap(work.begin(), work.end(), less);
       }
     }
   };
-  work.push_back({{0, 0, 0}, {1, 1, 1}, net, flatness(net, ord, H)});
+  {
+    Item root{{0, 0, 0}, {1, 1, 1}, take(), {}, {}};
+    std::copy(net, net + size, at(root.slot));
+    root.fit = affine_fit(points(root.slot), T);
+    root.f.deviation = root.fit.deviation;
+    control_box(points(root.slot), n, root.f);
+    items.push_back(root);
+    work.push_back({root.f.deviation, 0});
+  }
   refine(max_dev, max_leaves);
   if (fine_dev > 0.0 && (max_dev <= 0.0 || fine_dev < max_dev) && fine_factor > 1) {
     const int cap = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(max_leaves), done.size() * static_cast<std::size_t>(fine_factor)));
@@ -647,13 +917,19 @@ void build_leaves(const std::vector<double>& net, const std::array<int, 3>& ord,
     std::make_heap(work.begin(), work.end(), less);
     refine(fine_dev, cap);
   }
-  for (const auto& it : done) out.push_back({{it.lo, it.hi}, it.f});
+  out.reserve(out.size() + done.size());
+  for (const auto& ref : done) {
+    auto& it = items[static_cast<std::size_t>(ref.item)];
+    fit_frame(points(it.slot), n, it.fit, it.f);
+    out.push_back({it.lo, it.hi, it.f});
+  }
 }
 
 /// Bounds on the second partials of a polynomial piece (net: nc = 3 + m coordinates per point):
 /// d^2/dt_d dt_e is a Bezier polynomial with control points (scaled) second differences of the
-/// net, so their largest norm bounds it (convex hull property).
-StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::Piece& pc, int m) {
+/// net, so their largest norm bounds it (convex hull property). The largest squared norm is
+/// kept and its root taken once (the root is monotonic: the same bound).
+StepBounds second_derivative_bounds(const double* net, const Data::Piece& pc) {
   StepBounds b;
   b.valid = true;
   for (std::size_t d = 0; d < 3; ++d) {
@@ -663,51 +939,56 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
   const auto& o = pc.order;
   const int nc = pc.nc;
   const int stride[3] = {1, o[0], o[0] * o[1]};
-  const int n = o[0] * o[1] * o[2];
   for (int d = 0; d < 3; ++d)
     for (int e = d; e < 3; ++e) {
       const auto ud = static_cast<std::size_t>(d), ue = static_cast<std::size_t>(e);
       const double factor = d == e ? (o[ud] - 1.0) * (o[ud] - 2.0) * pc.inv_len[ud] * pc.inv_len[ud]
                                    : (o[ud] - 1.0) * (o[ue] - 1.0) * pc.inv_len[ud] * pc.inv_len[ue];
-      double bx = 0.0, bp = 0.0, bv[3] = {0.0, 0.0, 0.0};
+      double bx2 = 0.0, bp = 0.0, bv[3] = {0.0, 0.0, 0.0};
+      // The second difference at point i, over the points where it exists: d == e: P_i -
+      // 2 P_i+s + P_i+2s; d != e: P_i - P_i+sd - P_i+se + P_i+sd+se (in this order; only their
+      // magnitudes are used).
+      std::array<int, 3> lim = o;
+      std::ptrdiff_t o1, o2, o3 = 0;
+      if (d == e) {
+        lim[ud] -= 2;
+        o1 = static_cast<std::ptrdiff_t>(stride[d]) * nc;
+        o2 = 2 * o1;
+      } else {
+        lim[ud] -= 1;
+        lim[ue] -= 1;
+        o1 = static_cast<std::ptrdiff_t>(stride[d]) * nc;
+        o2 = static_cast<std::ptrdiff_t>(stride[e]) * nc;
+        o3 = o1 + o2;
+      }
       if (factor != 0.0)
-        for (int i = 0; i < n; ++i) {
-          const int idx[3] = {i % o[0], (i / o[0]) % o[1], i / (o[0] * o[1])};
-          // Corner offsets of the second difference: d == e: i, i+s, i+2s (1, -2, 1);
-          // d != e: i, i+sd, i+se, i+sd+se (1, -1, -1, 1).
-          int off[4];
-          double w[4];
-          int terms;
-          if (d == e) {
-            if (idx[d] + 2 >= o[ud]) continue;
-            off[0] = i, off[1] = i + stride[d], off[2] = i + 2 * stride[d];
-            w[0] = 1, w[1] = -2, w[2] = 1;
-            terms = 3;
-          } else {
-            if (idx[d] + 1 >= o[ud] || idx[e] + 1 >= o[ue]) continue;
-            off[0] = i, off[1] = i + stride[d], off[2] = i + stride[e], off[3] = i + stride[d] + stride[e];
-            w[0] = 1, w[1] = -1, w[2] = -1, w[3] = 1;
-            terms = 4;
-          }
-          double x2 = 0.0;
-          for (int h = 0; h < nc; ++h) {
-            double v = 0.0;
-            for (int k = 0; k < terms; ++k) v += w[k] * net[static_cast<std::size_t>(off[k] * nc + h)];
-            if (h < 3) {
-              x2 += v * v;
-              bv[h] = std::max(bv[h], std::abs(v));
-            } else {
-              bp = std::max(bp, std::abs(v));
+        for (int c = 0; c < lim[2]; ++c)
+          for (int bb = 0; bb < lim[1]; ++bb) {
+            const double* p = net + static_cast<std::ptrdiff_t>(o[0] * (bb + o[1] * c)) * nc;
+            for (int a = 0; a < lim[0]; ++a, p += nc) {
+              double v[3];
+              if (d == e)
+                for (int h = 0; h < 3; ++h) v[h] = p[h] + -2.0 * p[o1 + h] + p[o2 + h];
+              else
+                for (int h = 0; h < 3; ++h) v[h] = p[h] - p[o1 + h] - p[o2 + h] + p[o3 + h];
+              double x2 = 0.0;
+              for (int h = 0; h < 3; ++h) {
+                x2 += v[h] * v[h];
+                bv[h] = std::max(bv[h], std::abs(v[h]));
+              }
+              bx2 = std::max(bx2, x2);
+              if (d == e)
+                for (int h = 3; h < nc; ++h) bp = std::max(bp, std::abs(p[h] + -2.0 * p[o1 + h] + p[o2 + h]));
+              else
+                for (int h = 3; h < nc; ++h) bp = std::max(bp, std::abs(p[h] - p[o1 + h] - p[o2 + h] + p[o3 + h]));
             }
           }
-          bx = std::max(bx, std::sqrt(x2));
-        }
+      const double bx = std::sqrt(bx2);
       // Rounding in the differences is far below these bounds' slack; 1e-12 relative covers it.
       b.b2[ud][ue] = b.b2[ue][ud] = bx * factor * (1.0 + 1e-12);
       for (std::size_t k = 0; k < 3; ++k) b.b2v[ud][ue][k] = b.b2v[ue][ud][k] = bv[k] * factor * (1.0 + 1e-12);
       b.p2[ud][ue] = b.p2[ue][ud] = bp * factor * (1.0 + 1e-12);
     }
-  (void)m;
   for (std::size_t d = 0; d < 3; ++d)
     b.lip = std::max(b.lip, std::sqrt(b.b2[d][0] * b.b2[d][0] + b.b2[d][1] * b.b2[d][1] + b.b2[d][2] * b.b2[d][2]));
   return b;
@@ -715,132 +996,164 @@ StepBounds second_derivative_bounds(const std::vector<double>& net, const Data::
 
 /// Hodograph bound: |dX/dt_d| <= (order - 1) max |P_{i+1} - P_i| / len (polynomial nets with
 /// `stride` coordinates per point, xyz first).
-Vec3 hodograph_bounds(const std::vector<double>& net, const Data::Piece& pc, int stride) {
+Vec3 hodograph_bounds(const double* net, const Data::Piece& pc, int stride) {
   Vec3 out{};
-  const int n = pc.order[0] * pc.order[1] * pc.order[2];
+  const auto& o = pc.order;
   for (int d = 0; d < 3; ++d) {
     const auto dd = static_cast<std::size_t>(d);
-    if (pc.order[dd] < 2) continue;
-    const int step = d == 0 ? 1 : d == 1 ? pc.order[0] : pc.order[0] * pc.order[1];
-    double mx = 0.0;
-    for (int i = 0; i < n; ++i) {
-      const int idx = d == 0 ? i % pc.order[0] : d == 1 ? (i / pc.order[0]) % pc.order[1] : i / (pc.order[0] * pc.order[1]);
-      if (idx + 1 >= pc.order[dd]) continue;
-      double diff[3];
-      for (int h = 0; h < 3; ++h)
-        diff[h] = net[static_cast<std::size_t>((i + step) * stride + h)] - net[static_cast<std::size_t>(i * stride + h)];
-      mx = std::max(mx, norm3(diff));
-    }
+    if (o[dd] < 2) continue;
+    const std::ptrdiff_t step = static_cast<std::ptrdiff_t>(d == 0 ? 1 : d == 1 ? o[0] : o[0] * o[1]) * stride;
+    std::array<int, 3> lim = o;
+    lim[dd] -= 1;
+    double mx2 = 0.0;  // the largest squared norm (one root at the end: the same maximum)
+    for (int c = 0; c < lim[2]; ++c)
+      for (int b = 0; b < lim[1]; ++b) {
+        const double* p = net + static_cast<std::ptrdiff_t>(o[0] * (b + o[1] * c)) * stride;
+        for (int a = 0; a < lim[0]; ++a, p += stride) {
+          const double diff[3] = {p[step] - p[0], p[step + 1] - p[1], p[step + 2] - p[2]};
+          mx2 = std::max(mx2, dot3(diff, diff));
+        }
+      }
     // The same 1e-12 relative slack as the second-derivative bounds, for rounding.
-    out[dd] = (pc.order[dd] - 1) * mx * pc.inv_len[dd] * (1.0 + 1e-12);
+    out[dd] = (o[dd] - 1) * std::sqrt(mx2) * pc.inv_len[dd] * (1.0 + 1e-12);
   }
   return out;
 }
 
 /// Everything the sampler's certificates need of a polynomial piece (or part of one: `pc` gives
 /// the parameter box of `net`, nc = 3 + m coordinates per point).
-StepBounds step_bounds_of(const std::vector<double>& net, const Data::Piece& pc, int m) {
-  StepBounds b = second_derivative_bounds(net, pc, m);
+StepBounds step_bounds_of(const double* net, const Data::Piece& pc) {
+  StepBounds b = second_derivative_bounds(net, pc);
   b.slope = hodograph_bounds(net, pc, pc.nc);
   for (std::size_t d = 0; d < 3; ++d) b.degree[d] = pc.order[d] - 1;
   return b;
 }
 
-/// The bounds over each of the local_div^3 sub-boxes of a piece and its neighbours (StepBounds
-/// of the restricted nets).
-std::vector<StepBounds> local_bounds(const std::vector<double>& all, const Data::Piece& pc, int m) {
-  std::vector<StepBounds> local(static_cast<std::size_t>(Data::local_div * Data::local_div * Data::local_div));
-  Data::Piece sub = pc;
-  sub.local.clear();
-  constexpr double S = Data::local_div;
-  for (int c = 0; c < Data::local_div; ++c)
-    for (int b = 0; b < Data::local_div; ++b)
-      for (int a = 0; a < Data::local_div; ++a) {
-        const int idx[3] = {a, b, c};
-        Vec3 lo, hi;
-        for (std::size_t d = 0; d < 3; ++d) {
-          lo[d] = std::max(0.0, (idx[d] - 1) / S);
-          hi[d] = std::min(1.0, (idx[d] + 2) / S);
-          sub.lo[d] = pc.lo[d] + lo[d] * pc.len[d];
-          sub.len[d] = (hi[d] - lo[d]) * pc.len[d];
-          sub.inv_len[d] = 1.0 / sub.len[d];
-        }
-        local[static_cast<std::size_t>(a + Data::local_div * (b + Data::local_div * c))] =
-            step_bounds_of(restrict_net(all, pc.order, pc.nc, lo, hi), sub, m);
-      }
-  return local;
+/// The local bounds' intervals: k-th sub-box and its neighbours, in the piece's local [0, 1].
+double local_lo(int k) { return std::max(0.0, (k - 1) / double(Data::local_div)); }
+double local_hi(int k) { return std::min(1.0, (k + 2) / double(Data::local_div)); }
+
+/// A piece's local bounds before any is computed: its net restricted along u to each interval.
+/// @param all  the piece's net, nc coordinates per control point
+std::unique_ptr<Data::Local> make_local(const double* all, const Data::Piece& pc) {
+  constexpr int L = Data::local_div;
+  auto loc = std::make_unique<Data::Local>();
+  const std::size_t size = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+  loc->u_nets.resize(L * size);
+  for (int a = 0; a < L; ++a) {
+    double* q = loc->u_nets.data() + a * size;
+    std::copy(all, all + size, q);
+    restrict_dir(q, pc.order, pc.nc, 0, local_lo(a), local_hi(a));
+  }
+  loc->bounds.resize(static_cast<std::size_t>(L * L * L));
+  loc->done = std::make_unique<Once[]>(static_cast<std::size_t>(L * L * L));
+  return loc;
 }
 
-CellBuild build_cell(const vmodel::VCell& vc, int cell_index, int m, const LocatorOptions& opt) {
+/// The StepBounds of sub-box (a, b, c) of a piece and its neighbours: of the net restricted to
+/// them along u (kept in `loc`), then v, then w.
+StepBounds local_bounds(const Data::Local& loc, const Data::Piece& pc, int a, int b, int c) {
+  const std::size_t size = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
+  const double* qu = loc.u_nets.data() + static_cast<std::size_t>(a) * size;
+  std::vector<double> q(qu, qu + size);
+  restrict_dir(q.data(), pc.order, pc.nc, 1, local_lo(b), local_hi(b));
+  restrict_dir(q.data(), pc.order, pc.nc, 2, local_lo(c), local_hi(c));
+  // The fields step_bounds_of reads (not a copy of pc: its lazy members may be being written).
+  Data::Piece sub;
+  sub.order = pc.order;
+  sub.nc = pc.nc;
+  const int idx[3] = {a, b, c};
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double lo = local_lo(idx[d]), hi = local_hi(idx[d]);
+    sub.lo[d] = pc.lo[d] + lo * pc.len[d];
+    sub.len[d] = (hi - lo) * pc.len[d];
+    sub.inv_len[d] = 1.0 / sub.len[d];
+  }
+  return step_bounds_of(q.data(), sub);
+}
+
+/// A cell's Bezier pieces, before they are built.
+struct CellPieces {
+  Data::Cell cell;
+  std::vector<spline::TensorSpline<3>> pieces;
+  int H = 3;  ///< geometry coordinates: 4 for a rational cell
+};
+
+/// The cell's domain, breakpoints and Bezier pieces.
+CellPieces cell_pieces(const vmodel::VCell& vc) {
   const auto& s = vc.volume;
-  CellBuild cb;
+  CellPieces cp;
   for (int d = 0; d < 3; ++d) {
     const auto dd = static_cast<std::size_t>(d);
     if (s.knots(d).order() > max_order)
       throw Error("cell " + vc.name + ": order " + std::to_string(s.knots(d).order()) + " in direction " + "uvw"[d] +
                   "; expected at most " + std::to_string(max_order) + " for point location");
-    for (const auto& br : s.knots(d).breakpoints()) cb.cell.breaks[dd].push_back(br.value);
-    cb.cell.spans[dd] = static_cast<int>(cb.cell.breaks[dd].size()) - 1;
-    cb.cell.lo[dd] = s.domain(d)[0];
-    cb.cell.hi[dd] = s.domain(d)[1];
+    for (const auto& br : s.knots(d).breakpoints()) cp.cell.breaks[dd].push_back(br.value);
+    cp.cell.spans[dd] = static_cast<int>(cp.cell.breaks[dd].size()) - 1;
+    cp.cell.lo[dd] = s.domain(d)[0];
+    cp.cell.hi[dd] = s.domain(d)[1];
   }
-  const auto pieces = spline::bezier_pieces(s);
-  const int H = s.rational() ? 4 : 3;
+  cp.pieces = spline::bezier_pieces(s);
+  cp.H = s.rational() ? 4 : 3;
+  return cp;
+}
+
+/// Builds one Bezier piece: its Piece record, its net (written to `pool`, pc.net values on) and
+/// its leaves (appended to `leaves`). The whole-piece StepBounds are left to first use.
+/// @param piece_index  the piece's index among all pieces of the locator
+/// @param H            the cell's geometry coordinates (CellPieces::H)
+Data::Piece build_piece(const spline::TensorSpline<3>& bp, int H, int cell_index, int piece_index, std::size_t net, int m,
+                        const LocatorOptions& opt, double* pool, std::vector<LocatorLeaf>& leaves) {
+  Data::Piece pc;
+  pc.cell = cell_index;
+  pc.order = bp.orders();
+  pc.H = H;
+  pc.nc = H + m;
+  pc.net = net;
+  pc.k = H == 3 ? pick_kernels<3>(pc.order, pc.nc) : pick_kernels<4>(pc.order, pc.nc);
+  for (int d = 0; d < 3; ++d) {
+    const auto dd = static_cast<std::size_t>(d);
+    pc.lo[dd] = bp.domain(d)[0];
+    pc.len[dd] = bp.domain(d)[1] - bp.domain(d)[0];
+    pc.inv_len[dd] = 1.0 / pc.len[dd];
+  }
+  const int n = bp.size();
+  std::vector<double> g(static_cast<std::size_t>(n * H));
+  double* all = pool + net;
+  for (int i = 0; i < n; ++i) {
+    const auto q = bp.point(i);
+    const double w = H == 4 ? bp.weights()[static_cast<std::size_t>(i)] : 1.0;
+    for (int h = 0; h < 3; ++h) g[static_cast<std::size_t>(i * H + h)] = w * q[static_cast<std::size_t>(h)];
+    if (H == 4) g[static_cast<std::size_t>(i * H + 3)] = w;
+    for (int h = 0; h < H; ++h) all[i * pc.nc + h] = g[static_cast<std::size_t>(i * H + h)];
+    for (int h = 0; h < m; ++h) all[i * pc.nc + H + h] = w * q[static_cast<std::size_t>(3 + h)];
+  }
+  pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g.data(), pc, H);
+  std::vector<LeafBox> lv;
   const double min_diag = 100.0 * opt.tolerance;
-  for (std::size_t pi = 0; pi < pieces.size(); ++pi) {
-    const auto& bp = pieces[pi];
-    Data::Piece pc;
-    pc.cell = cell_index;
-    pc.order = bp.orders();
-    pc.H = H;
-    pc.nc = H + m;
-    pc.k = H == 3 ? pick_kernels<3>(pc.order, pc.nc) : pick_kernels<4>(pc.order, pc.nc);
+  build_leaves(g.data(), pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
+  leaves.reserve(lv.size());
+  for (const auto& [lo, hi, fl] : lv) {
+    LocatorLeaf leaf;
+    leaf.cell = cell_index;
+    leaf.piece = piece_index;
     for (int d = 0; d < 3; ++d) {
       const auto dd = static_cast<std::size_t>(d);
-      pc.lo[dd] = bp.domain(d)[0];
-      pc.len[dd] = bp.domain(d)[1] - bp.domain(d)[0];
-      pc.inv_len[dd] = 1.0 / pc.len[dd];
+      // The piece's own end knots at the ends, so leaves tile the domain without gaps.
+      leaf.lo[dd] = lo[dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + lo[dd] * pc.len[dd];
+      leaf.hi[dd] = hi[dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + hi[dd] * pc.len[dd];
     }
-    const int n = bp.size();
-    std::vector<double> g(static_cast<std::size_t>(n * H)), all(static_cast<std::size_t>(n * pc.nc));
-    for (int i = 0; i < n; ++i) {
-      const auto q = bp.point(i);
-      const double w = H == 4 ? bp.weights()[static_cast<std::size_t>(i)] : 1.0;
-      for (int h = 0; h < 3; ++h) g[static_cast<std::size_t>(i * H + h)] = w * q[static_cast<std::size_t>(h)];
-      if (H == 4) g[static_cast<std::size_t>(i * H + 3)] = w;
-      for (int h = 0; h < H; ++h) all[static_cast<std::size_t>(i * pc.nc + h)] = g[static_cast<std::size_t>(i * H + h)];
-      for (int h = 0; h < m; ++h) all[static_cast<std::size_t>(i * pc.nc + H + h)] = w * q[static_cast<std::size_t>(3 + h)];
-    }
-    pc.lipschitz = H == 4 ? Vec3{inf, inf, inf} : hodograph_bounds(g, pc, H);
-    // The local bounds (local_div^3 sub-boxes) are computed on first use (step_bounds): a
-    // model of thousands of pieces would otherwise pay seconds here for pieces no voxel needs.
-    if (pc.k.all_first) pc.bounds = step_bounds_of(all, pc, m);
-    std::vector<std::pair<std::array<Vec3, 2>, Flatness>> lv;
-    build_leaves(g, pc.order, H, min_diag, opt.leaf_deviation, opt.fine_leaf_deviation, opt.fine_leaf_factor, opt.max_leaves_per_piece, lv);
-    for (const auto& [box, fl] : lv) {
-      LocatorLeaf leaf;
-      leaf.cell = cell_index;
-      leaf.piece = static_cast<int>(pi);
-      for (int d = 0; d < 3; ++d) {
-        const auto dd = static_cast<std::size_t>(d);
-        // The piece's own end knots at the ends, so leaves tile the domain without gaps.
-        leaf.lo[dd] = box[0][dd] <= 0.0 ? bp.domain(d)[0] : pc.lo[dd] + box[0][dd] * pc.len[dd];
-        leaf.hi[dd] = box[1][dd] >= 1.0 ? bp.domain(d)[1] : pc.lo[dd] + box[1][dd] * pc.len[dd];
-      }
-      leaf.box_lo = fl.box_lo;
-      leaf.box_hi = fl.box_hi;
-      leaf.frame_origin = fl.origin;
-      leaf.frame = fl.frame;
-      leaf.frame_lo = fl.frame_lo;
-      leaf.frame_hi = fl.frame_hi;
-      for (std::size_t k = 0; k < 3; ++k)
-        leaf.frame_scale[k] = std::sqrt(fl.frame[k][0] * fl.frame[k][0] + fl.frame[k][1] * fl.frame[k][1] + fl.frame[k][2] * fl.frame[k][2]);
-      cb.leaves.push_back(leaf);
-    }
-    cb.pieces.push_back(pc);
-    cb.nets.push_back(std::move(all));
+    leaf.box_lo = fl.box_lo;
+    leaf.box_hi = fl.box_hi;
+    leaf.frame_origin = fl.origin;
+    leaf.frame = fl.frame;
+    leaf.frame_lo = fl.frame_lo;
+    leaf.frame_hi = fl.frame_hi;
+    for (std::size_t k = 0; k < 3; ++k)
+      leaf.frame_scale[k] = std::sqrt(fl.frame[k][0] * fl.frame[k][0] + fl.frame[k][1] * fl.frame[k][1] + fl.frame[k][2] * fl.frame[k][2]);
+    leaves.push_back(leaf);
   }
-  return cb;
+  return pc;
 }
 
 /// Median-split BVH over the leaf boxes.
@@ -913,30 +1226,42 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
       throw Error("cell " + model.cells[static_cast<std::size_t>(c)].name + ": " +
                   std::to_string(model.cells[static_cast<std::size_t>(c)].volume.dim()) +
                   " coordinates per control point; expected " + std::to_string(model.dim()) + " (xyz and the model's properties)");
-  std::vector<CellBuild> built(static_cast<std::size_t>(nc));
-  tbb::parallel_for(0, nc, [&](int c) {
-    built[static_cast<std::size_t>(c)] = build_cell(model.cells[static_cast<std::size_t>(c)], c, D.m, opt_);
-  });
+  // Cells, then all pieces of all cells, in parallel; each piece writes its own pre-sized slots
+  // (its Piece, its part of the pool, its leaves), concatenated in order afterwards: the same
+  // locator whatever the thread count.
+  std::vector<CellPieces> cells(static_cast<std::size_t>(nc));
+  tbb::parallel_for(0, nc, [&](int c) { cells[static_cast<std::size_t>(c)] = cell_pieces(model.cells[static_cast<std::size_t>(c)]); });
+  struct Job {
+    int cell, local;
+  };
+  std::vector<Job> jobs;
+  std::vector<std::size_t> nets;  // pool offset per piece
   std::size_t size = 0;
-  for (auto& cb : built)
-    for (const auto& net : cb.nets) size += net.size();
-  D.pool.reserve(size);
-  for (auto& cb : built) {
-    cb.cell.first_piece = static_cast<int>(D.pieces.size());
-    for (auto& leaf : cb.leaves) {
-      leaf.piece += cb.cell.first_piece;
-      D.leaves.push_back(leaf);
+  for (int c = 0; c < nc; ++c) {
+    auto& cp = cells[static_cast<std::size_t>(c)];
+    cp.cell.first_piece = static_cast<int>(jobs.size());
+    for (std::size_t i = 0; i < cp.pieces.size(); ++i) {
+      jobs.push_back({c, static_cast<int>(i)});
+      nets.push_back(size);
+      size += static_cast<std::size_t>(cp.pieces[i].size()) * static_cast<std::size_t>(cp.H + D.m);
     }
-    for (std::size_t i = 0; i < cb.pieces.size(); ++i) {
-      auto pc = cb.pieces[i];
-      pc.net = D.pool.size();
-      D.pool.insert(D.pool.end(), cb.nets[i].begin(), cb.nets[i].end());
-      D.pieces.push_back(pc);
-    }
-    D.cells.push_back(std::move(cb.cell));
   }
+  D.pool.resize(size);
+  D.pieces.resize(jobs.size());
+  std::vector<std::vector<LocatorLeaf>> leaves(jobs.size());
+  tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t i) {
+    const auto& cp = cells[static_cast<std::size_t>(jobs[i].cell)];
+    D.pieces[i] = build_piece(cp.pieces[static_cast<std::size_t>(jobs[i].local)], cp.H, jobs[i].cell, static_cast<int>(i), nets[i], D.m,
+                              opt_, D.pool.data(), leaves[i]);
+  });
+  std::size_t total = 0;
+  for (const auto& l : leaves) total += l.size();
+  D.leaves.reserve(total);
+  for (const auto& l : leaves) D.leaves.insert(D.leaves.end(), l.begin(), l.end());
+  for (auto& cp : cells) D.cells.push_back(std::move(cp.cell));
   build_bvh(D);
-  D.local_once = std::make_unique<std::once_flag[]>(D.pieces.size());
+  D.bounds_once = std::make_unique<Once[]>(D.pieces.size());
+  D.local_once = std::make_unique<Once[]>(D.pieces.size());
   // Local bounds cost local_div^3 StepBounds per piece (about 250 kB) and milliseconds to
   // compute: for models of thousands of pieces (finely refined cells) the whole-piece bounds
   // serve instead, a few more anchors against gigabytes and seconds.
@@ -1122,22 +1447,25 @@ bool Locator::expand(int cell, const Vec3& t, Expansion& out) const {
   return true;
 }
 
-const StepBounds& Locator::step_bounds(int piece) const noexcept { return data_->pieces[static_cast<std::size_t>(piece)].bounds; }
+const StepBounds& Locator::step_bounds(int piece) const noexcept {
+  const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
+  if (!pc.k.all_first) return pc.bounds;  // not valid
+  data_->bounds_once[static_cast<std::size_t>(piece)]([&] { pc.bounds = step_bounds_of(data_->pool.data() + pc.net, pc); });
+  return pc.bounds;
+}
 
 const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
   const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
-  if (!pc.k.all_first || !data_->use_local) return pc.bounds;
-  std::call_once(data_->local_once[static_cast<std::size_t>(piece)], [&] {
-    const std::size_t n = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
-    const std::vector<double> all(data_->pool.begin() + static_cast<std::ptrdiff_t>(pc.net),
-                                  data_->pool.begin() + static_cast<std::ptrdiff_t>(pc.net + n));
-    pc.local = local_bounds(all, pc, data_->m);
-  });
+  if (!pc.k.all_first || !data_->use_local) return step_bounds(piece);
+  data_->local_once[static_cast<std::size_t>(piece)]([&] { pc.local = make_local(data_->pool.data() + pc.net, pc); });
   double s[3];
   Data::local(pc, t, s);
   int idx[3];
   for (int d = 0; d < 3; ++d) idx[d] = std::min(Data::local_div - 1, static_cast<int>(s[d] * Data::local_div));
-  return pc.local[static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]))];
+  const auto k = static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]));
+  Data::Local& loc = *pc.local;
+  loc.done[k]([&] { loc.bounds[k] = local_bounds(loc, pc, idx[0], idx[1], idx[2]); });
+  return loc.bounds[k];
 }
 
 namespace {
