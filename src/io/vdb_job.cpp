@@ -374,8 +374,11 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
     const int nk = k1 - k0, nj = j1 - j0;
     Scratch& s = scratch.local();
     const std::size_t voxels = static_cast<std::size_t>(nk) * static_cast<std::size_t>(nj) * static_cast<std::size_t>(nx);
+    // Only the counts are cleared: a voxel's sums are set by its first sample (as 0 + value, the
+    // floats of clearing and adding) and read only where its count is positive, so the sums of
+    // void voxels (most of a box) cost nothing.
     s.count.assign(voxels, 0);
-    s.sums.assign(voxels * static_cast<std::size_t>(channels), 0.0);
+    s.sums.resize(voxels * static_cast<std::size_t>(channels));
     s.fractions.resize(static_cast<std::size_t>(M));
     // Fine rows of grid rows [j0 N, j1 N) are image rows [nyf - j1 N, nyf - j0 N) (grid.hpp).
     // The last band samples up to the padded row count, so its first row stays block-aligned;
@@ -396,12 +399,12 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
           for (int i_f = 0; i_f < nx * N; ++i_f) {
             if (s.band.cell_at(r, i_f) < 0) continue;
             const std::size_t v = row + static_cast<std::size_t>(i_f / N);
-            ++s.count[v];
+            const bool first = s.count[v]++ == 0;
             const float* p = s.band.props_at(r, i_f);
             double* acc = s.sums.data() + v * static_cast<std::size_t>(channels);
-            for (int h = 0; h < P; ++h) acc[h] += p[h];
+            for (int h = 0; h < P; ++h) acc[h] = (first ? 0.0 : acc[h]) + p[h];
             mapper.fractions(p, s.fractions.data());
-            for (int m = 0; m < M; ++m) acc[P + m] += s.fractions[static_cast<std::size_t>(m)];
+            for (int m = 0; m < M; ++m) acc[P + m] = (first ? 0.0 : acc[P + m]) + s.fractions[static_cast<std::size_t>(m)];
           }
         }
       }
