@@ -228,14 +228,21 @@ Banded Banded::identity(int n) {
 Banded Banded::from_dense(const Eigen::MatrixXd& T) {
   Banded b;
   b.cols = static_cast<int>(T.cols());
+  const auto m = static_cast<std::size_t>(T.rows());
+  // Each row's first and last non-zero column, in one sweep in storage order (column-major).
+  std::vector<Eigen::Index> lo(m, T.cols()), hi(m, -1);
+  for (Eigen::Index i = 0; i < T.cols(); ++i)
+    for (Eigen::Index j = 0; j < T.rows(); ++j)
+      if (T(j, i) != 0.0) {
+        const auto uj = static_cast<std::size_t>(j);
+        lo[uj] = std::min(lo[uj], i);
+        hi[uj] = std::max(hi[uj], i);
+      }
   std::vector<double> row;
-  for (Eigen::Index j = 0; j < T.rows(); ++j) {
-    Eigen::Index a = 0, e = T.cols() - 1;
-    while (a < T.cols() && T(j, a) == 0.0) ++a;
-    while (e > a && T(j, e) == 0.0) --e;
+  for (std::size_t j = 0; j < m; ++j) {
     row.clear();
-    for (Eigen::Index i = a; i <= e && a < T.cols(); ++i) row.push_back(T(j, i));
-    b.push_row(a < T.cols() ? static_cast<int>(a) : 0, row.data(), row.size());
+    for (Eigen::Index i = lo[j]; i <= hi[j]; ++i) row.push_back(T(static_cast<Eigen::Index>(j), i));
+    b.push_row(hi[j] >= lo[j] ? static_cast<int>(lo[j]) : 0, row.data(), row.size());
   }
   return b;
 }
