@@ -434,6 +434,17 @@ AffineFit affine_fit(const double* X, const FitTables& T) {
   // The largest squared distance, then one root (the root is monotonic: the same maximum).
   double dev2_max = 0.0;
   p = X;
+  // A point's squared distance from the fit (the tail of a row, or every point without SSE2).
+  const auto point_dev2 = [&](const double* q, int a, int b, int c) {
+    const double e0 = q[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
+    const double e1 = q[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
+    const double e2 = q[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
+    double dev2 = 0.0;
+    dev2 += e0 * e0;
+    dev2 += e1 * e1;
+    dev2 += e2 * e2;
+    return dev2;
+  };
 #if defined(__SSE2__)
   // Two points at a time along u, one per lane: the same operations per point. Lanes keep
   // their own maxima (neither takes a NaN: maxpd returns its second operand then, as std::max).
@@ -457,16 +468,7 @@ AffineFit affine_fit(const double* X, const FitTables& T) {
         const __m128d dev2 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(e0, e0), _mm_mul_pd(e1, e1)), _mm_mul_pd(e2, e2));
         vmax = _mm_max_pd(dev2, vmax);
       }
-      for (; a < ou; ++a, p += 3) {
-        const double e0 = p[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
-        const double e1 = p[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
-        const double e2 = p[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
-        double dev2 = 0.0;
-        dev2 += e0 * e0;
-        dev2 += e1 * e1;
-        dev2 += e2 * e2;
-        dev2_max = std::max(dev2_max, dev2);
-      }
+      for (; a < ou; ++a, p += 3) dev2_max = std::max(dev2_max, point_dev2(p, a, b, c));
     }
   double lanes[2];
   _mm_storeu_pd(lanes, vmax);
@@ -474,16 +476,7 @@ AffineFit affine_fit(const double* X, const FitTables& T) {
 #else
   for (int c = 0; c < ow; ++c)
     for (int b = 0; b < ov; ++b)
-      for (int a = 0; a < ou; ++a, p += 3) {
-        const double e0 = p[0] - m0 - a00 * x0[a] - a10 * x1[b] - a20 * x2[c];
-        const double e1 = p[1] - m1 - a01 * x0[a] - a11 * x1[b] - a21 * x2[c];
-        const double e2 = p[2] - m2 - a02 * x0[a] - a12 * x1[b] - a22 * x2[c];
-        double dev2 = 0.0;
-        dev2 += e0 * e0;
-        dev2 += e1 * e1;
-        dev2 += e2 * e2;
-        dev2_max = std::max(dev2_max, dev2);
-      }
+      for (int a = 0; a < ou; ++a, p += 3) dev2_max = std::max(dev2_max, point_dev2(p, a, b, c));
 #endif
   AffineFit f;
   f.mean = {m0, m1, m2};

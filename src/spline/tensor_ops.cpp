@@ -41,45 +41,10 @@ TensorSpline<P> from_net(std::array<KnotVector, P> knots, int dim, bool rational
 
 template <int P>
 Net<P> apply_along(const Net<P>& net, int d, const Eigen::MatrixXd& T) {
-  const auto dd = static_cast<std::size_t>(d);
-  const int n = net.extents[dd];
-  const int m = static_cast<int>(T.rows());
-  if (T.cols() != n) throw Error("internal: transfer matrix has " + std::to_string(T.cols()) + " columns; expected " + std::to_string(n));
-  // inner = entries between neighbours along d; outer = lines of lines.
-  std::ptrdiff_t inner = 1, outer = 1;
-  for (int e = 0; e < d; ++e) inner *= net.extents[static_cast<std::size_t>(e)];
-  for (int e = d + 1; e < P; ++e) outer *= net.extents[static_cast<std::size_t>(e)];
-  Net<P> out;
-  out.extents = net.extents;
-  out.extents[dd] = m;
-  out.H = net.H;
-  const std::ptrdiff_t H = net.H;
-  out.values.assign(static_cast<std::size_t>(outer * m * inner * H), 0.0);
   // Transfer matrices are banded (refinement, elevation, restriction: a few non-zeros per row):
   // each row's non-zero columns are found once, not once per line (that scan made applying a
   // map to a surface with thousands of control points per direction quadratic per line).
-  std::vector<int> lo(static_cast<std::size_t>(m), n), hi(static_cast<std::size_t>(m), -1);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < m; ++j)
-      if (T(j, i) != 0.0) {
-        lo[static_cast<std::size_t>(j)] = std::min(lo[static_cast<std::size_t>(j)], i);
-        hi[static_cast<std::size_t>(j)] = std::max(hi[static_cast<std::size_t>(j)], i);
-      }
-  // Each (outer, inner) pair is one line: n entries with stride inner*H.
-  for (std::ptrdiff_t o = 0; o < outer; ++o) {
-    const double* src = net.values.data() + o * n * inner * H;
-    double* dst = out.values.data() + o * m * inner * H;
-    for (int j = 0; j < m; ++j) {
-      double* drow = dst + j * inner * H;
-      for (int i = lo[static_cast<std::size_t>(j)]; i <= hi[static_cast<std::size_t>(j)]; ++i) {
-        const double c = T(j, i);
-        if (c == 0.0) continue;
-        const double* srow = src + i * inner * H;
-        for (std::ptrdiff_t k = 0; k < inner * H; ++k) drow[k] += c * srow[k];
-      }
-    }
-  }
-  return out;
+  return apply_along(net, d, Banded::from_dense(T));
 }
 
 std::vector<double> span_samples(const KnotVector& kv, int k) {
