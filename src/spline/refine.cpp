@@ -245,6 +245,9 @@ TensorSpline<P> to_bezier_form(const TensorSpline<P>& s, int dir) {
   std::vector<double> add;
   for (const auto& b : c.to.breakpoints())
     for (int r = b.multiplicity; r < kv.order(); ++r) add.push_back(b.value);
+  // Already in Bezier form along dir (a clamped vector with every knot at full multiplicity): the
+  // map is the identity, and applying it would only copy the net, twice.
+  if (add.empty() && kv.clamped()) return s;
   return apply_map(s, dir, insert_into(c, std::move(add)));
 }
 
