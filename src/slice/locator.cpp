@@ -1219,39 +1219,65 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
       throw Error("cell " + model.cells[static_cast<std::size_t>(c)].name + ": " +
                   std::to_string(model.cells[static_cast<std::size_t>(c)].volume.dim()) +
                   " coordinates per control point; expected " + std::to_string(model.dim()) + " (xyz and the model's properties)");
-  // Cells, then all pieces of all cells, in parallel; each piece writes its own pre-sized slots
-  // (its Piece, its part of the pool, its leaves), concatenated in order afterwards: the same
-  // locator whatever the thread count.
-  std::vector<CellPieces> cells(static_cast<std::size_t>(nc));
-  tbb::parallel_for(0, nc, [&](int c) { cells[static_cast<std::size_t>(c)] = cell_pieces(model.cells[static_cast<std::size_t>(c)]); });
-  struct Job {
-    int cell, local;
-  };
-  std::vector<Job> jobs;
+  // The pieces of each cell are known from its knots (one per non-empty span triple, each with
+  // the cell's orders): every piece's slots are sized up front. Cells are then extracted and
+  // built in batches of consecutive cells whose Bezier pieces take at most batch_bytes (a
+  // thousand-span fillet cell alone makes 100k pieces, hundreds of MB as splines), each batch's
+  // cells and then its pieces in parallel, and its pieces freed before the next batch; each
+  // piece writes its own slots (its Piece, its part of the pool, its leaves), concatenated in
+  // order afterwards: the same locator whatever the thread count.
+  constexpr double batch_bytes = 64.0 * 1024 * 1024;
+  std::vector<std::size_t> first_piece(static_cast<std::size_t>(nc) + 1, 0);
+  std::vector<double> cell_bytes(static_cast<std::size_t>(nc), 0.0);
   std::vector<std::size_t> nets;  // pool offset per piece
   std::size_t size = 0;
   for (int c = 0; c < nc; ++c) {
-    auto& cp = cells[static_cast<std::size_t>(c)];
-    cp.cell.first_piece = static_cast<int>(jobs.size());
-    for (std::size_t i = 0; i < cp.pieces.size(); ++i) {
-      jobs.push_back({c, static_cast<int>(i)});
-      nets.push_back(size);
-      size += static_cast<std::size_t>(cp.pieces[i].size()) * static_cast<std::size_t>(cp.H + D.m);
+    const auto& v = model.cells[static_cast<std::size_t>(c)].volume;
+    std::size_t pieces = 1, per_piece = 1;
+    for (int d = 0; d < 3; ++d) {
+      pieces *= v.knots(d).breakpoints().size() - 1;
+      per_piece *= static_cast<std::size_t>(v.knots(d).order());
     }
+    const std::size_t values = per_piece * static_cast<std::size_t>((v.rational() ? 4 : 3) + D.m);
+    for (std::size_t i = 0; i < pieces; ++i) {
+      nets.push_back(size);
+      size += values;
+    }
+    first_piece[static_cast<std::size_t>(c) + 1] = first_piece[static_cast<std::size_t>(c)] + pieces;
+    cell_bytes[static_cast<std::size_t>(c)] = static_cast<double>(pieces) * static_cast<double>(per_piece * static_cast<std::size_t>(v.dim())) * 8.0;
   }
   D.pool.resize(size);
-  D.pieces.resize(jobs.size());
-  std::vector<std::vector<LocatorLeaf>> leaves(jobs.size());
-  tbb::parallel_for(std::size_t{0}, jobs.size(), [&](std::size_t i) {
-    const auto& cp = cells[static_cast<std::size_t>(jobs[i].cell)];
-    D.pieces[i] = build_piece(cp.pieces[static_cast<std::size_t>(jobs[i].local)], cp.H, jobs[i].cell, static_cast<int>(i), nets[i], D.m,
-                              opt_, D.pool.data(), leaves[i]);
-  });
+  D.pieces.resize(nets.size());
+  D.cells.resize(static_cast<std::size_t>(nc));
+  std::vector<std::vector<LocatorLeaf>> leaves(nets.size());
+  for (int c0 = 0; c0 < nc;) {
+    int c1 = c0 + 1;
+    for (double bytes = cell_bytes[static_cast<std::size_t>(c0)]; c1 < nc && bytes + cell_bytes[static_cast<std::size_t>(c1)] <= batch_bytes; ++c1)
+      bytes += cell_bytes[static_cast<std::size_t>(c1)];
+    std::vector<CellPieces> cells(static_cast<std::size_t>(c1 - c0));
+    tbb::parallel_for(c0, c1, [&](int c) { cells[static_cast<std::size_t>(c - c0)] = cell_pieces(model.cells[static_cast<std::size_t>(c)]); });
+    for (int c = c0; c < c1; ++c)
+      if (cells[static_cast<std::size_t>(c - c0)].pieces.size() != first_piece[static_cast<std::size_t>(c) + 1] - first_piece[static_cast<std::size_t>(c)])
+        throw Error("cell " + model.cells[static_cast<std::size_t>(c)].name + ": internal: Bezier extraction made " +
+                        std::to_string(cells[static_cast<std::size_t>(c - c0)].pieces.size()) + " pieces; expected one per span",
+                    ErrorKind::failed);
+    tbb::parallel_for(first_piece[static_cast<std::size_t>(c0)], first_piece[static_cast<std::size_t>(c1)], [&](std::size_t i) {
+      const int c = static_cast<int>(std::upper_bound(first_piece.begin(), first_piece.end(), i) - first_piece.begin()) - 1;
+      const auto& cp = cells[static_cast<std::size_t>(c - c0)];
+      D.pieces[i] = build_piece(cp.pieces[i - first_piece[static_cast<std::size_t>(c)]], cp.H, c, static_cast<int>(i), nets[i], D.m, opt_,
+                                D.pool.data(), leaves[i]);
+    });
+    for (int c = c0; c < c1; ++c) {
+      auto& cell = cells[static_cast<std::size_t>(c - c0)].cell;
+      cell.first_piece = static_cast<int>(first_piece[static_cast<std::size_t>(c)]);
+      D.cells[static_cast<std::size_t>(c)] = std::move(cell);
+    }
+    c0 = c1;
+  }
   std::size_t total = 0;
   for (const auto& l : leaves) total += l.size();
   D.leaves.reserve(total);
   for (const auto& l : leaves) D.leaves.insert(D.leaves.end(), l.begin(), l.end());
-  for (auto& cp : cells) D.cells.push_back(std::move(cp.cell));
   build_bvh(D);
   D.bounds_once = std::make_unique<Once[]>(D.pieces.size());
   D.local_once = std::make_unique<Once[]>(D.pieces.size());
