@@ -34,6 +34,27 @@ Map1D identity_map(const KnotVector& kv) { return {kv, detail::Banded::identity(
 /// the rows and knots are held as gap buffers split where the next knot goes (the rows before
 /// it never change again, those after it only shift): O(n + k order) for k knots into n rows,
 /// where inserting into flat vectors moved every later row and knot at each insertion.
+/// A sequence held as a gap buffer split at a position that moves mostly forward: the part
+/// before it in order, the part after it reversed (its next element at the back), so that
+/// replacing elements at the split costs nothing for the rest.
+template <class T>
+struct GapBuffer {
+  std::vector<T> left, right;
+
+  std::size_t size() const noexcept { return left.size() + right.size(); }
+  const T& at(std::size_t i) const { return i < left.size() ? left[i] : right[right.size() - 1 - (i - left.size())]; }
+  /// Moves the split to `at` (0 <= at <= size()).
+  void split(std::size_t at) {
+    for (; left.size() < at; right.pop_back()) left.push_back(std::move(right.back()));
+    for (; left.size() > at; left.pop_back()) right.push_back(std::move(left.back()));
+  }
+  /// The whole sequence, in order.
+  std::vector<T> take() {
+    split(size());
+    return std::move(left);
+  }
+};
+
 Map1D insert_into(Map1D m, std::vector<double> add) {
   std::sort(add.begin(), add.end());
   const int order = m.to.order();
@@ -43,34 +64,17 @@ Map1D insert_into(Map1D m, std::vector<double> add) {
     std::vector<double> c;  // T(i, first + k) = c[k]
   };
   const detail::Banded& B = m.T;
-  const int cols = B.cols;
-  // Before the split: left (in order); after it: right, reversed (right.back() comes next).
-  std::vector<Row> left, right;
-  left.reserve(static_cast<std::size_t>(B.rows()) + add.size());
-  right.reserve(static_cast<std::size_t>(B.rows()));
+  GapBuffer<Row> rows;
+  rows.left.reserve(static_cast<std::size_t>(B.rows()) + add.size());
   for (int j = B.rows() - 1; j >= 0; --j) {
     const auto uj = static_cast<std::size_t>(j);
-    right.push_back({B.first[uj], std::vector<double>(B.vals.begin() + static_cast<std::ptrdiff_t>(B.start[uj]),
-                                                      B.vals.begin() + static_cast<std::ptrdiff_t>(B.start[uj + 1]))});
+    rows.right.push_back({B.first[uj], std::vector<double>(B.vals.begin() + static_cast<std::ptrdiff_t>(B.start[uj]),
+                                                           B.vals.begin() + static_cast<std::ptrdiff_t>(B.start[uj + 1]))});
   }
-  std::vector<double> kleft, kright(m.to.knots().rbegin(), m.to.knots().rend());
-  kleft.reserve(kright.size() + add.size());
-  const auto row = [&](int i) -> const Row& {
-    const auto ui = static_cast<std::size_t>(i);
-    return ui < left.size() ? left[ui] : right[right.size() - 1 - (ui - left.size())];
-  };
-  const auto knot = [&](int i) {
-    const auto ui = static_cast<std::size_t>(i);
-    return ui < kleft.size() ? kleft[ui] : kright[kright.size() - 1 - (ui - kleft.size())];
-  };
-  const auto split_rows = [&](std::size_t at) {
-    for (; left.size() < at; right.pop_back()) left.push_back(std::move(right.back()));
-    for (; left.size() > at; left.pop_back()) right.push_back(std::move(left.back()));
-  };
-  const auto split_knots = [&](std::size_t at) {
-    for (; kleft.size() < at; kright.pop_back()) kleft.push_back(kright.back());
-    for (; kleft.size() > at; kleft.pop_back()) kright.push_back(kleft.back());
-  };
+  GapBuffer<double> knots;
+  knots.right.assign(m.to.knots().rbegin(), m.to.knots().rend());
+  knots.left.reserve(knots.right.size() + add.size());
+  const auto knot = [&](int i) { return knots.at(static_cast<std::size_t>(i)); };
   const auto combine = [](const Row& x, double ax, const Row& y, double ay) {
     Row out;
     if (x.c.empty() && y.c.empty()) return out;
@@ -93,43 +97,41 @@ Map1D insert_into(Map1D m, std::vector<double> add) {
       throw Error("knot " + num(t) + " outside the domain [" + num(m.to.front()) + ", " + num(m.to.back()) +
                   "]; expected a value inside it");
     // The knots <= t before the split; t's multiplicity is the run of equal knots just before it.
-    while (!kright.empty() && kright.back() <= t) split_knots(kleft.size() + 1);
-    const int u = static_cast<int>(kleft.size());
+    while (!knots.right.empty() && knots.right.back() <= t) knots.split(knots.left.size() + 1);
+    const int u = static_cast<int>(knots.left.size());
     int mult = 0;
-    while (mult < u && kleft[static_cast<std::size_t>(u - 1 - mult)] == t) ++mult;
+    while (mult < u && knots.left[static_cast<std::size_t>(u - 1 - mult)] == t) ++mult;
     if (mult >= order)
       throw Error("knot " + num(t) + " already has multiplicity " + std::to_string(mult) +
                   "; expected at most the order (" + std::to_string(order) + ")");
     // The span t_mu <= t < t_mu+1 (at the right end: the last non-empty span), as KnotVector::find_span.
-    const int n = static_cast<int>(kleft.size() + kright.size()) - order;
+    const int n = static_cast<int>(knots.size()) - order;
     int mu = std::clamp(u - 1, p, n - 1);
     while (mu > p && knot(mu) == knot(mu + 1)) --mu;
-    split_rows(static_cast<std::size_t>(mu) + 1);  // rows 0..mu before the split
+    rows.split(static_cast<std::size_t>(mu) + 1);  // rows 0..mu before the split
     if (p == 0) {  // order 1: the basis function of span mu splits in two with the same coefficient
-      right.push_back(left.back());
+      rows.right.push_back(rows.left.back());
     } else {
-      // Rows mu-p+1..mu become convex combinations; the old row mu moves to mu+1.
+      // Rows mu-p+1..mu become convex combinations (Boehm); the old row mu moves to mu+1.
       fresh.clear();
       for (int i = mu - p + 1; i <= mu; ++i) {
         const double ti = knot(i);
         const double a = (t - ti) / (knot(i + p) - ti);
-        fresh.push_back(combine(row(i), a, row(i - 1), 1.0 - a));
+        fresh.push_back(combine(rows.at(static_cast<std::size_t>(i)), a, rows.at(static_cast<std::size_t>(i - 1)), 1.0 - a));
       }
-      Row last = std::move(left.back());
-      left.resize(static_cast<std::size_t>(mu - p + 1));
-      for (Row& r : fresh) left.push_back(std::move(r));
-      right.push_back(std::move(last));
+      Row last = std::move(rows.left.back());
+      rows.left.resize(static_cast<std::size_t>(mu - p + 1));
+      for (Row& r : fresh) rows.left.push_back(std::move(r));
+      rows.right.push_back(std::move(last));
     }
-    split_knots(static_cast<std::size_t>(mu) + 1);
-    kleft.push_back(t);
+    knots.split(static_cast<std::size_t>(mu) + 1);
+    knots.left.push_back(t);
   }
   detail::Banded T;
-  T.cols = cols;
-  split_rows(left.size() + right.size());
-  for (const Row& r : left) T.push_row(r.first, r.c.data(), r.c.size());
-  split_knots(kleft.size() + kright.size());
+  T.cols = B.cols;
+  for (const Row& r : rows.take()) T.push_row(r.first, r.c.data(), r.c.size());
   m.T = std::move(T);
-  m.to = KnotVector(order, std::move(kleft));
+  m.to = KnotVector(order, knots.take());
   return m;
 }
 
