@@ -42,8 +42,7 @@ TensorSpline<P> from_net(std::array<KnotVector, P> knots, int dim, bool rational
 template <int P>
 Net<P> apply_along(const Net<P>& net, int d, const Eigen::MatrixXd& T) {
   // Transfer matrices are banded (refinement, elevation, restriction: a few non-zeros per row):
-  // each row's non-zero columns are found once, not once per line (that scan made applying a
-  // map to a surface with thousands of control points per direction quadratic per line).
+  // each row's non-zero columns are found once, not once per line of the net.
   return apply_along(net, d, Banded::from_dense(T));
 }
 
@@ -182,6 +181,7 @@ template Net<3> to_net(const TensorSpline<3>&);
 template TensorSpline<1> from_net<1>(std::array<KnotVector, 1>, int, bool, Net<1>);
 template TensorSpline<2> from_net<2>(std::array<KnotVector, 2>, int, bool, Net<2>);
 template TensorSpline<3> from_net<3>(std::array<KnotVector, 3>, int, bool, Net<3>);
+
 Banded Banded::identity(int n) {
   Banded b;
   b.cols = n;
@@ -236,6 +236,12 @@ Net<P> apply_along(const Net<P>& net, int d, const Banded& T) {
   const int n = net.extents[dd];
   const int m = T.rows();
   if (T.cols != n) throw Error("internal: transfer matrix has " + std::to_string(T.cols) + " columns; expected " + std::to_string(n));
+  for (int j = 0; j < m; ++j) {
+    const auto uj = static_cast<std::size_t>(j);
+    const auto len = static_cast<std::ptrdiff_t>(T.start[uj + 1] - T.start[uj]);
+    if (len > 0 && (T.first[uj] < 0 || T.first[uj] + len > n))
+      throw Error("internal: banded transfer row " + std::to_string(j) + " reaches beyond column " + std::to_string(n - 1));
+  }
   std::ptrdiff_t inner = 1, outer = 1;
   for (int e = 0; e < d; ++e) inner *= net.extents[static_cast<std::size_t>(e)];
   for (int e = d + 1; e < P; ++e) outer *= net.extents[static_cast<std::size_t>(e)];
@@ -255,7 +261,6 @@ Net<P> apply_along(const Net<P>& net, int d, const Banded& T) {
         const double c = T.vals[k];
         if (c == 0.0) continue;
         const int i = T.first[uj] + static_cast<int>(k - T.start[uj]);
-        if (i < 0 || i >= n) throw Error("internal: banded transfer row " + std::to_string(j) + " reaches column " + std::to_string(i));
         const double* srow = src + i * inner * H;
         for (std::ptrdiff_t q = 0; q < inner * H; ++q) drow[q] += c * srow[q];
       }
