@@ -1667,9 +1667,11 @@ LocateResult Locator::locate(const Vec3& p, const LocateResult* hint) const {
 
 std::array<Vec3, 2> model_bounds(const vmodel::VModel& model) {
   if (model.cells.empty()) throw Error("the model has no cells; expected at least one volumetric cell to slice");
+  // Cells in parallel (a thousand-span cell's Bezier form takes a while), combined in cell order.
+  std::vector<std::array<std::vector<double>, 2>> boxes(model.cells.size());
+  tbb::parallel_for(std::size_t{0}, boxes.size(), [&](std::size_t c) { boxes[c] = spline::bounding_box(model.cells[c].volume, 3); });
   std::array<Vec3, 2> b{Vec3{inf, inf, inf}, Vec3{-inf, -inf, -inf}};
-  for (const auto& c : model.cells) {
-    const auto bb = spline::bounding_box(c.volume, 3);
+  for (const auto& bb : boxes) {
     for (std::size_t d = 0; d < 3; ++d) {
       b[0][d] = std::min(b[0][d], bb[0][d]);
       b[1][d] = std::max(b[1][d], bb[1][d]);

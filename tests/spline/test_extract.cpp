@@ -2,10 +2,12 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 
 #include "poly.hpp"
 #include "trivox/error.hpp"
 #include "trivox/spline/extract.hpp"
+#include "trivox/spline/refine.hpp"
 
 using namespace trivox::spline;
 using trivox::test::random_params;
@@ -94,4 +96,29 @@ TEST_CASE("bounding boxes contain the spline and are exact for a box") {
   const auto b = bounding_box(Trivariate({lin, lin, lin}, 3, pts));
   CHECK(b[0] == std::vector<double>{-1, 0, 4});
   CHECK(b[1] == std::vector<double>{2, 2, 5});
+}
+
+TEST_CASE("bounding boxes are the boxes of the Bezier pieces' control points, of the first coordinates") {
+  // The box is read from the Bezier form's net and of the requested coordinates only: it must be
+  // the box over bezier_pieces' control boxes (the definition), float for float.
+  for (bool rational : {false, true}) {
+    const Trivariate s = sample_trivariate(rational);
+    std::array<std::vector<double>, 2> want{std::vector<double>(4, std::numeric_limits<double>::infinity()),
+                                            std::vector<double>(4, -std::numeric_limits<double>::infinity())};
+    const auto pieces = bezier_pieces(s);
+    REQUIRE(pieces.size() > 1);
+    for (const auto& p : pieces) {
+      const auto b = p.control_box();
+      for (std::size_t h = 0; h < 4; ++h) want[0][h] = std::min(want[0][h], b[0][h]), want[1][h] = std::max(want[1][h], b[1][h]);
+    }
+    for (int k : {1, 3, 4}) {
+      const auto box = bounding_box(s, k);
+      REQUIRE(box[0].size() == static_cast<std::size_t>(k));
+      for (std::size_t h = 0; h < static_cast<std::size_t>(k); ++h) {
+        CHECK(box[0][h] == want[0][h]);
+        CHECK(box[1][h] == want[1][h]);
+      }
+    }
+    CHECK(bounding_box(s)[0] == want[0]);
+  }
 }

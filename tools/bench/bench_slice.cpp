@@ -144,7 +144,9 @@ int main(int argc, char** argv) {
 
   // 2. One 1516 x 2524 slice on one thread.
   {
-    const auto one = scaled(model, {1516 * 25.4 / 600, 2524 * 25.4 / 300, 0.027});
+    // A hundredth of a voxel less than 1516 x 2524 pitches: exactly that many voxels (2524 pitches
+    // in floating point cover 2524.0000001 of them, and the grid rounds up).
+    const auto one = scaled(model, {1515.99 * 25.4 / 600, 2523.99 * 25.4 / 300, 0.027});
     const auto s = run(one, tmp / "one", 1);
     std::printf("%-44s %12.3f %14.4g\n",
                 ("one slice " + std::to_string(s.grid.count[0]) + " x " + std::to_string(s.grid.count[1]) +
