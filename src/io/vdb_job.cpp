@@ -548,7 +548,9 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   density->setGridClass(openvdb::GRID_FOG_VOLUME);
   finish(density, "density");
   color->setVectorType(openvdb::VEC_INVARIANT);
-  auto cd = color->deepCopy();
+  // Cd shares color's tree: OpenVDB writes it once and the second grid as an instance of it
+  // (the reader links them back), so neither the memory nor the file holds the colours twice.
+  auto cd = color->copy();
   finish(color, "color");
   finish(cd, "Cd");
   for (int m = 0; m < M; ++m) {
@@ -632,9 +634,13 @@ void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
     if (grids->size() != merged.size())
       throw Error(parts[p].string() + ": " + std::to_string(grids->size()) + " grids; expected " +
                   std::to_string(merged.size()) + " like " + parts[0].string());
+    std::vector<const void*> trees;  // the trees merged so far (Cd shares color's: merge it once)
     for (std::size_t g = 0; g < grids->size(); ++g) {
       auto& into = merged[g];
       auto& from = (*grids)[g];
+      const void* tree = into->baseTreePtr().get();
+      const bool instance = std::find(trees.begin(), trees.end(), tree) != trees.end();
+      trees.push_back(tree);
       if (from->getName() != into->getName() || from->type() != into->type() ||
           from->transform() != into->transform())
         throw Error(parts[p].string() + ": grid " + std::to_string(g) + " (" + from->getName() + ", " + from->type() +
@@ -642,6 +648,7 @@ void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
                     "); expected parts of one job");
       // The parts hold disjoint whole leaves (shards are whole 8-layer blocks): merging moves
       // them, as the job itself merges its tasks' trees.
+      if (instance) continue;
       if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(into)) {
         f->tree().merge(openvdb::gridPtrCast<openvdb::FloatGrid>(from)->tree());
       } else if (auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(into)) {
