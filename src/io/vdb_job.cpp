@@ -121,12 +121,15 @@ Layout make_layout(const vmodel::VModel& model, const slice::Palette& palette) {
 using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 using Vec3Leaf = openvdb::Vec3STree::LeafNodeType;
 
-/// One task's output: its own trees (disjoint from every other task's) and sums.
+/// One task's output: its leaves (disjoint from every other task's), per grid in the order made,
+/// and sums. Leaves, not trees: a tree of its own per task and grid would allocate internal
+/// nodes (256 KB and more each) only to free them when merged, and the allocator hands such
+/// blocks back to the system, so that every task's would be faulted in afresh.
 struct TaskOut {
   int index = -1;
-  openvdb::FloatTree::Ptr density;
-  openvdb::Vec3STree::Ptr color;
-  std::vector<openvdb::FloatTree::Ptr> materials, extras;
+  std::vector<std::unique_ptr<FloatLeaf>> density;
+  std::vector<std::unique_ptr<Vec3Leaf>> color;
+  std::vector<std::vector<std::unique_ptr<FloatLeaf>>> materials, extras;
   std::int64_t active = 0, fractional = 0, failures = 0, samples = 0;
   double density_sum = 0.0;               // sum of density
   std::vector<double> material_sum;       // sum of fraction x density
@@ -412,10 +415,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
     out.samples = static_cast<std::int64_t>(voxels) * n3;
 
     // Leaves, one 8^3 block at a time, every grid with the same active voxels.
-    out.density = std::make_shared<openvdb::FloatTree>(0.0f);
-    out.color = std::make_shared<openvdb::Vec3STree>(openvdb::Vec3s(0.0f));
-    for (int m = 0; m < M; ++m) out.materials.push_back(std::make_shared<openvdb::FloatTree>(0.0f));
-    for (std::size_t e = 0; e < layout.extra_props.size(); ++e) out.extras.push_back(std::make_shared<openvdb::FloatTree>(0.0f));
+    out.materials.resize(static_cast<std::size_t>(M));
+    out.extras.resize(layout.extra_props.size());
     std::vector<FloatLeaf*> mat_leaves(static_cast<std::size_t>(M)), extra_leaves(layout.extra_props.size());
     std::vector<float> mean(static_cast<std::size_t>(channels));
     for (int bj = j0; bj < j1; bj += leaf_dim)
@@ -431,10 +432,12 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               }
         if (!any) continue;
         const openvdb::Coord origin(bi, bj, k0);
-        auto* dl = new FloatLeaf(origin, 0.0f, false);
-        auto* cl = new Vec3Leaf(origin, openvdb::Vec3s(0.0f), false);
-        for (auto& l : mat_leaves) l = new FloatLeaf(origin, 0.0f, false);
-        for (auto& l : extra_leaves) l = new FloatLeaf(origin, 0.0f, false);
+        auto* dl = out.density.emplace_back(std::make_unique<FloatLeaf>(origin, 0.0f, false)).get();
+        auto* cl = out.color.emplace_back(std::make_unique<Vec3Leaf>(origin, openvdb::Vec3s(0.0f), false)).get();
+        for (std::size_t m = 0; m < mat_leaves.size(); ++m)
+          mat_leaves[m] = out.materials[m].emplace_back(std::make_unique<FloatLeaf>(origin, 0.0f, false)).get();
+        for (std::size_t e = 0; e < extra_leaves.size(); ++e)
+          extra_leaves[e] = out.extras[e].emplace_back(std::make_unique<FloatLeaf>(origin, 0.0f, false)).get();
         for (int k = 0; k < nk; ++k)
           for (int j = bj; j < ej; ++j)
             for (int i = bi; i < ei; ++i) {
@@ -468,15 +471,11 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               for (std::size_t e = 0; e < extra_leaves.size(); ++e)
                 extra_leaves[e]->setValueOn(off, mean[static_cast<std::size_t>(layout.extra_props[e])]);
             }
-        out.density->addLeaf(dl);
-        out.color->addLeaf(cl);
-        for (int m = 0; m < M; ++m) out.materials[static_cast<std::size_t>(m)]->addLeaf(mat_leaves[static_cast<std::size_t>(m)]);
-        for (std::size_t e = 0; e < extra_leaves.size(); ++e) out.extras[e]->addLeaf(extra_leaves[e]);
       }
     return out;
   };
 
-  // The grids, filled by merging the tasks' trees in task order.
+  // The grids, filled with the tasks' leaves in task order.
   auto density = openvdb::FloatGrid::create(0.0f);
   auto color = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
   std::vector<openvdb::FloatGrid::Ptr> materials, extras;
@@ -502,10 +501,14 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
           tbb::make_filter<int, std::shared_ptr<TaskOut>>(
               tbb::filter_mode::parallel, [&](int t) { return std::make_shared<TaskOut>(run_task(t)); }) &
           tbb::make_filter<std::shared_ptr<TaskOut>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<TaskOut> o) {
-            density->tree().merge(*o->density);
-            color->tree().merge(*o->color);
-            for (int m = 0; m < M; ++m) materials[static_cast<std::size_t>(m)]->tree().merge(*o->materials[static_cast<std::size_t>(m)]);
-            for (std::size_t e = 0; e < extras.size(); ++e) extras[e]->tree().merge(*o->extras[e]);
+            // The grids take the leaves over (each is a new leaf position: tasks are disjoint).
+            auto adopt = [](auto& tree, auto& leaves) {
+              for (auto& l : leaves) tree.addLeaf(l.release());
+            };
+            adopt(density->tree(), o->density);
+            adopt(color->tree(), o->color);
+            for (int m = 0; m < M; ++m) adopt(materials[static_cast<std::size_t>(m)]->tree(), o->materials[static_cast<std::size_t>(m)]);
+            for (std::size_t e = 0; e < extras.size(); ++e) adopt(extras[e]->tree(), o->extras[e]);
             sum.active_voxels += o->active;
             sum.fractional_voxels += o->fractional;
             sum.inversion_failures += o->failures;
