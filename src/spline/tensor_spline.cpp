@@ -250,12 +250,13 @@ struct FastBasis {
   double N[2 * kMaxOrderStack];  // row 0 values, row 1 first derivatives (length `order` each)
 };
 
-template <int O, int H>
+template <int OU, int OV, int OW, int H>
 void fast_contract(const double* pts, int dim, const FastBasis (&b)[3], bool d1, double* out) {
-  // O > 0: every direction has order O (loops unroll); O == 0: orders from b.
+  // Orders > 0: that direction's order (loops unroll; a surface's third direction has order 1);
+  // 0: the order from b.
   constexpr int cap = H ? H : 64;
   const int D = H ? H : dim;
-  const int ou = O ? O : b[0].order, ov = O ? O : b[1].order, ow = O ? O : b[2].order;
+  const int ou = OU ? OU : b[0].order, ov = OV ? OV : b[1].order, ow = OW ? OW : b[2].order;
   double val[cap], du[cap], dv[cap], dw[cap];
   for (int h = 0; h < D; ++h) val[h] = du[h] = dv[h] = dw[h] = 0.0;
   const double *Nu = b[0].N, *Nv = b[1].N, *Nw = b[2].N;
@@ -305,18 +306,18 @@ void fast_contract(const double* pts, int dim, const FastBasis (&b)[3], bool d1,
   }
 }
 
-template <int O>
+template <int OU, int OV, int OW>
 void fast_contract_dim(const double* pts, int dim, const FastBasis (&b)[3], bool d1, double* out) {
   switch (dim) {
-    case 1: return fast_contract<O, 1>(pts, 1, b, d1, out);
-    case 2: return fast_contract<O, 2>(pts, 2, b, d1, out);
-    case 3: return fast_contract<O, 3>(pts, 3, b, d1, out);
-    case 4: return fast_contract<O, 4>(pts, 4, b, d1, out);
-    case 5: return fast_contract<O, 5>(pts, 5, b, d1, out);
-    case 6: return fast_contract<O, 6>(pts, 6, b, d1, out);
-    case 7: return fast_contract<O, 7>(pts, 7, b, d1, out);
-    case 8: return fast_contract<O, 8>(pts, 8, b, d1, out);
-    default: return fast_contract<O, 0>(pts, dim, b, d1, out);
+    case 1: return fast_contract<OU, OV, OW, 1>(pts, 1, b, d1, out);
+    case 2: return fast_contract<OU, OV, OW, 2>(pts, 2, b, d1, out);
+    case 3: return fast_contract<OU, OV, OW, 3>(pts, 3, b, d1, out);
+    case 4: return fast_contract<OU, OV, OW, 4>(pts, 4, b, d1, out);
+    case 5: return fast_contract<OU, OV, OW, 5>(pts, 5, b, d1, out);
+    case 6: return fast_contract<OU, OV, OW, 6>(pts, 6, b, d1, out);
+    case 7: return fast_contract<OU, OV, OW, 7>(pts, 7, b, d1, out);
+    case 8: return fast_contract<OU, OV, OW, 8>(pts, 8, b, d1, out);
+    default: return fast_contract<OU, OV, OW, 0>(pts, dim, b, d1, out);
   }
 }
 
@@ -351,13 +352,19 @@ bool fast_eval(const TensorSpline<P>& s, const std::array<double, P>& t, int max
   }
   const double* pts = s.points().data();
   const bool d1 = max_order == 1;
+  // Equal orders 2..4 in every direction of a trivariate or a surface (whose third direction
+  // has order 1) unroll; the same operations in the same order as the runtime-order loops.
   const int o = b[0].order;
-  const bool uniform = P == 3 && b[1].order == o && b[2].order == o;
-  switch (uniform ? o : 0) {
-    case 2: fast_contract_dim<2>(pts, s.dim(), b, d1, out); break;
-    case 3: fast_contract_dim<3>(pts, s.dim(), b, d1, out); break;
-    case 4: fast_contract_dim<4>(pts, s.dim(), b, d1, out); break;
-    default: fast_contract_dim<0>(pts, s.dim(), b, d1, out); break;
+  const bool uniform = b[1].order == o && (P == 3 ? b[2].order == o : P == 2);
+  const int key = uniform ? (P == 3 ? o : 10 + o) : 0;
+  switch (key) {
+    case 2: fast_contract_dim<2, 2, 2>(pts, s.dim(), b, d1, out); break;
+    case 3: fast_contract_dim<3, 3, 3>(pts, s.dim(), b, d1, out); break;
+    case 4: fast_contract_dim<4, 4, 4>(pts, s.dim(), b, d1, out); break;
+    case 12: fast_contract_dim<2, 2, 1>(pts, s.dim(), b, d1, out); break;
+    case 13: fast_contract_dim<3, 3, 1>(pts, s.dim(), b, d1, out); break;
+    case 14: fast_contract_dim<4, 4, 1>(pts, s.dim(), b, d1, out); break;
+    default: fast_contract_dim<0, 0, 0>(pts, s.dim(), b, d1, out); break;
   }
   return true;
 }
