@@ -1616,7 +1616,11 @@ NewtonResult Locator::solve_in_leaf(int leaf, const Vec3& p, const Vec3* start) 
     r = newton(l.cell, p, c, l.lo, l.hi);
     if (r.status != NewtonStatus::failed) return r;
   }
-  NewtonResult s = subdivide(*this, *data_, l.cell, p, l.lo, l.hi, 1);
+  // Three levels (27, then 27 per failing part): next to a fillet's degenerate rail (a face
+  // collapsed onto a curve, singular Jacobian) one level left the filleted teapot's slice with a
+  // voxel neither placed nor excluded (tests/data/teapot_rail.json); the deeper levels run only
+  // on parts whose Newton fails, so they cost nothing elsewhere.
+  NewtonResult s = subdivide(*this, *data_, l.cell, p, l.lo, l.hi, 3);
   return s;
 }
 
