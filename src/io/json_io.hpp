@@ -4,7 +4,15 @@
 /// every failure is a trivox::Error (bad_input) reading "<file>: <JSON pointer>: <what was
 /// found>; expected <what>" (or "<file>: line L, column C: malformed JSON: ..." for syntax).
 #pragma once
+#include <tbb/parallel_for.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+#include <algorithm>
 #include <array>
+#include <atomic>
+#include <optional>
 #include <charconv>
 #include <climits>
 #include <cmath>
@@ -95,7 +103,143 @@ private:
   std::string message_;
 };
 
+/// The large documents' fast path (models of thousand-span cells run to 100 MB): the elements of
+/// the top-level object's big arrays ("cells") parsed in parallel, each on its own, and put back
+/// in order into the rest of the document, parsed without them. JSON values are context-free, so
+/// this is the same DOM as one parse; it is taken only when every piece parses (then the whole is
+/// valid: the pieces joined by commas inside their brackets) and the top-level keys are plain
+/// and distinct. Otherwise nothing: the caller parses the whole (and reports its errors).
+inline std::optional<json> parse_split(std::string_view text) {
+  struct Member {
+    std::string key;
+    std::size_t open = 0, close = 0;             // the array's brackets
+    std::vector<std::pair<std::size_t, std::size_t>> items;  // element spans
+  };
+  std::vector<Member> members;
+  std::vector<std::string> keys;
+  int depth = 0;
+  bool in_string = false, top_seen = false, expect_key = false;
+  std::size_t string_start = 0, item_start = 0;
+  Member* current = nullptr;  // the big array being split (depth 2 inside it)
+  std::string last_key;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        if (depth == 1 && expect_key) return std::nullopt;  // escaped keys: the slow path
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+        if (depth == 1 && expect_key) {
+          last_key.assign(text.substr(string_start + 1, i - string_start - 1));
+          keys.push_back(last_key);
+          expect_key = false;
+        }
+      }
+      continue;
+    }
+    if (depth >= 3) {
+      // Inside an element: only brackets, braces and quotes matter, and long runs of numbers
+      // have none of them. Skip 16 bytes at a time that hold none (SSE2).
+#if defined(__SSE2__)
+      while (i + 16 <= text.size()) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(text.data() + i));
+        // '[' 0x5b, ']' 0x5d, '{' 0x7b, '}' 0x7d: with bit 5 cleared, 0x5b or 0x5d; and '"'.
+        const __m128i up = _mm_and_si128(v, _mm_set1_epi8(static_cast<char>(0xdf)));
+        const __m128i hit = _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(up, _mm_set1_epi8(0x5b)), _mm_cmpeq_epi8(up, _mm_set1_epi8(0x5d))),
+                                         _mm_cmpeq_epi8(v, _mm_set1_epi8('"')));
+        const int mask = _mm_movemask_epi8(hit);
+        if (mask != 0) {
+          i += static_cast<std::size_t>(__builtin_ctz(static_cast<unsigned>(mask)));
+          break;
+        }
+        i += 16;
+      }
+      if (i >= text.size()) break;
+#endif
+    }
+    const char c2 = text[i];
+    switch (c2) {
+      case '"':
+        in_string = true;
+        string_start = i;
+        break;
+      case '{':
+      case '[':
+        if (depth == 0) {
+          if (c2 != '{' || top_seen) return std::nullopt;
+          top_seen = expect_key = true;
+        } else if (depth == 1 && c2 == '[') {
+          members.push_back({last_key, i, 0, {}});
+          current = &members.back();
+          item_start = i + 1;
+        }
+        ++depth;
+        break;
+      case '}':
+      case ']':
+        if (depth == 2 && current && c2 == ']') {
+          current->items.emplace_back(item_start, i);
+          current->close = i;
+          current = nullptr;
+        }
+        if (--depth < 0) return std::nullopt;
+        break;
+      case ',':
+        if (depth == 1) expect_key = true;
+        if (depth == 2 && current) {
+          current->items.emplace_back(item_start, i);
+          item_start = i + 1;
+        }
+        break;
+      default:
+        break;
+    }
+  }
+  if (depth != 0 || in_string || !top_seen) return std::nullopt;
+  std::vector<std::string> sorted = keys;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return std::nullopt;
+  // Split only the big arrays; an empty one ("[]", one blank item) stays in the rest.
+  constexpr std::size_t big = std::size_t{1} << 20;
+  std::erase_if(members, [&](const Member& m) {
+    return m.close - m.open < big || (m.items.size() == 1 && text.substr(m.items[0].first, m.items[0].second - m.items[0].first)
+                                                                     .find_first_not_of(" \t\n\r") == std::string_view::npos);
+  });
+  if (members.empty()) return std::nullopt;
+  std::string rest;
+  std::size_t at = 0;
+  for (const auto& m : members) {
+    rest.append(text.substr(at, m.open + 1 - at));
+    at = m.close;
+  }
+  rest.append(text.substr(at));
+  std::vector<std::pair<std::size_t, std::size_t>> spans;
+  for (const auto& m : members) spans.insert(spans.end(), m.items.begin(), m.items.end());
+  std::vector<json> parsed(spans.size());
+  std::atomic<bool> ok{true};
+  tbb::parallel_for(std::size_t{0}, spans.size(), [&](std::size_t k) {
+    const auto piece = text.substr(spans[k].first, spans[k].second - spans[k].first);
+    parsed[k] = json::parse(piece.begin(), piece.end(), nullptr, /*allow_exceptions=*/false);
+    if (parsed[k].is_discarded()) ok = false;
+  });
+  if (!ok) return std::nullopt;
+  json root = json::parse(rest, nullptr, /*allow_exceptions=*/false);
+  if (root.is_discarded() || !root.is_object()) return std::nullopt;
+  std::size_t k = 0;
+  for (const auto& m : members) {
+    json& a = root[m.key];
+    if (!a.is_array() || !a.empty()) return std::nullopt;
+    auto& arr = a.get_ref<json::array_t&>();
+    arr.reserve(m.items.size());
+    for (std::size_t e = 0; e < m.items.size(); ++e) arr.push_back(std::move(parsed[k++]));
+  }
+  return root;
+}
+
 inline json parse(const Source& src, std::string_view text) {
+  if (text.size() >= (std::size_t{8} << 20))
+    if (auto fast = parse_split(text)) return std::move(*fast);
   json root;
   PositionedParser parser(root);
   json::sax_parse(text.begin(), text.end(), &parser, nlohmann::detail::input_format_t::json,

@@ -1,11 +1,15 @@
 #include "trivox/io/model_json.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <array>
 #include <charconv>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <optional>
+#include <exception>
 #include <nlohmann/json.hpp>
 
 #include "json_io.hpp"
@@ -156,20 +160,45 @@ std::vector<Item> read_items(const Source& src, const json& root, const char* li
   const std::string lp = std::string("/") + list;
   const std::string what = std::string("{\"name\", \"") + key + "\"}";
   expect_array(src, *j, lp, "an array of " + what + " objects");
-  std::vector<Item> out;
-  out.reserve(j->size());
-  for (std::size_t i = 0; i < j->size(); ++i) {
-    const std::string ip = child(lp, i);
-    const json& item = expect_object(src, (*j)[i], ip, "an object " + what);
-    std::string name = read_name(src, item, ip, names);
-    out.push_back({std::move(name),
-                   read_spline<P>(src, require(src, item, ip, key, what), child(ip, key), shape)});
-    if constexpr (P == 3) {
-      read_trims(src, item, ip, shape, out.back(), 0);
-      read_shepard(src, item, ip, shape, out.back());
+  // Items in parallel (a thousand-span cell's points take a while), with the serial reading's
+  // errors: each item's object and name first, in order (the names must be unique), then its
+  // spline, trims and Shepard data; the error reported is that of the first item, in order, that
+  // has one, and within it the first the serial reading would meet.
+  const std::size_t n = j->size();
+  std::vector<std::optional<Item>> out(n);
+  std::vector<std::exception_ptr> error(n);
+  std::size_t named = n;  // items before the first object or name error
+  for (std::size_t i = 0; i < n && named == n; ++i) {
+    try {
+      const std::string ip = child(lp, i);
+      const json& item = expect_object(src, (*j)[i], ip, "an object " + what);
+      out[i].emplace();
+      out[i]->name = read_name(src, item, ip, names);
+    } catch (...) {
+      error[i] = std::current_exception();
+      named = i;
     }
   }
-  return out;
+  tbb::parallel_for(std::size_t{0}, std::min(named, n), [&](std::size_t i) {
+    try {
+      const std::string ip = child(lp, i);
+      const json& item = (*j)[i];
+      Item& it = *out[i];
+      it = Item{std::move(it.name), read_spline<P>(src, require(src, item, ip, key, what), child(ip, key), shape)};
+      if constexpr (P == 3) {
+        read_trims(src, item, ip, shape, it, 0);
+        read_shepard(src, item, ip, shape, it);
+      }
+    } catch (...) {
+      error[i] = std::current_exception();
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i)
+    if (error[i]) std::rethrow_exception(error[i]);
+  std::vector<Item> items;
+  items.reserve(n);
+  for (auto& it : out) items.push_back(std::move(*it));
+  return items;
 }
 
 // ------------------------------------------------------------------------------------------

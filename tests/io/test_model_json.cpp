@@ -460,3 +460,69 @@ TEST_CASE("truncated or corrupted model files only ever give trivox::Error", "[i
     }
   }
 }
+
+// --------------------------------------------------------------------------------------------
+// Large files: the cells' elements are parsed in parallel (json_io::parse_split)
+
+namespace {
+/// awkward_model plus big cells (about 8 MB of text each), so that the text passes the
+/// threshold of the parallel parse.
+VModel big_model() {
+  VModel m = awkward_model();
+  std::mt19937_64 rng(77);
+  for (int c = 0; c < 2; ++c) {
+    const KnotVector k = KnotVector::uniform(4, 37);  // 40 functions per direction
+    std::vector<double> pts;
+    for (int i = 0; i < 40 * 40 * 40 * 6; ++i) pts.push_back(random_finite(rng));
+    m.cells.push_back({"big" + std::to_string(c), Trivariate({k, k, k}, 6, pts)});
+  }
+  return m;
+}
+/// Line and column of byte `at` (1-based), counted independently of the reader.
+std::string line_column(const std::string& text, std::size_t at) {
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i < at; ++i) {
+    if (text[i] == '\n') ++line, col = 1;
+    else ++col;
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+}  // namespace
+
+TEST_CASE("a large model reads the same as through one serial parse, errors included", "[io][json]") {
+  const VModel m = big_model();
+  const std::string text = write_model_json(m);
+  REQUIRE(text.size() > (std::size_t{8} << 20));
+  const VModel back = read_model_json(text, "big.json");
+  // (In parentheses: Catch would print a failing comparison's million-element operands.)
+  CHECK((back == m));
+  CHECK((bits(back) == bits(m)));
+  // A top-level key spelled with an escape takes the one-parse path (the split skips such
+  // documents): the same model.
+  std::string escaped = text;
+  const auto units = escaped.find("\"units\"");
+  REQUIRE(units != std::string::npos);
+  escaped.replace(units, 7, "\"\\u0075nits\"");
+  CHECK((bits(read_model_json(escaped, "big.json")) == bits(m)));
+
+  // A syntax error deep in the last big cell: the position of the whole file.
+  std::string broken = text;
+  const auto at = broken.rfind("big1");
+  const auto digit = broken.find_first_of("0123456789", broken.find("\"points\"", at));
+  REQUIRE(digit != std::string::npos);
+  broken.insert(digit, "x");
+  check_message(error_of([&] { read_model_json(broken, "big.json"); }),
+                {"big.json: " + line_column(broken, digit) + ": malformed JSON"});
+
+  // Errors in two cells: the one a serial reading meets first. A bad order in cell 2 ("big0")
+  // comes before a repeated name in cell 3.
+  json doc = json::parse(text);
+  doc["cells"][2]["trivariate"]["orders"][0] = 0;
+  doc["cells"][3]["name"] = "big0";
+  const std::string two = doc.dump(1);
+  REQUIRE(two.size() > (std::size_t{8} << 20));
+  check_message(error_of([&] { read_model_json(two, "big.json"); }), {"big.json: /cells/2/trivariate/orders/0"});
+  doc["cells"][2]["trivariate"]["orders"][0] = 4;
+  check_message(error_of([&] { read_model_json(doc.dump(1), "big.json"); }),
+                {"big.json: /cells/3/name", "is also the name of /cells/2"});
+}
