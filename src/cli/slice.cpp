@@ -49,19 +49,38 @@ std::string duration(double s) {
 io::SliceProgress make_progress(const std::string& mode, const char* unit = "layers", const char* what = "voxels") {
   if (mode == "never") return {};
   const bool bar = mode == "bar" || (mode == "auto" && isatty(STDERR_FILENO));
-  auto last = std::make_shared<double>(-1e9);
-  return [bar, last, unit, what](int done, int total, std::int64_t voxels, double seconds) {
-    const double rate = seconds > 0 ? voxels / seconds : 0.0;
-    const double eta = done > 0 ? seconds * (total - done) / done : 0.0;
+  // The rate and the ETA are measured from the first report on: the time before it holds the
+  // model's setup (the locator) and a whole group of layers in flight, which would make the
+  // first ETAs far too long (52 minutes for the 13-second teapot print).
+  struct State {
+    double last = -1e9;
+    bool have_base = false;
+    int base_done = 0;
+    std::int64_t base_voxels = 0;
+    double base_seconds = 0.0;
+  };
+  auto st = std::make_shared<State>();
+  return [bar, st, unit, what](int done, int total, std::int64_t voxels, double seconds) {
+    if (!st->have_base) {
+      st->have_base = true;
+      st->base_done = done, st->base_voxels = voxels, st->base_seconds = seconds;
+    }
+    const double span = seconds - st->base_seconds;
+    const bool measured = done > st->base_done && span > 0.0;
+    const double rate = measured ? static_cast<double>(voxels - st->base_voxels) / span : seconds > 0 ? voxels / seconds : 0.0;
+    const std::string eta = done == total ? duration(0.0)
+                            : measured   ? duration(span * (total - done) / (done - st->base_done))
+                                         : std::string("--");
+    auto* last = &st->last;
     if (bar) {
       const int width = 30, fill = total ? done * width / total : width;
       std::fprintf(stderr, "\r[%.*s%.*s] %d/%d %s, %.3g %s/s, ETA %s   ", fill, "##############################",
-                   width - fill, "..............................", done, total, unit, rate, what, duration(eta).c_str());
+                   width - fill, "..............................", done, total, unit, rate, what, eta.c_str());
       if (done == total) std::fprintf(stderr, "\n");
     } else if (seconds - *last >= 5.0 || done == total) {
       *last = seconds;
       std::fprintf(stderr, "trivox slice: %d/%d %s, %.3g %s/s, elapsed %s, ETA %s\n", done, total, unit, rate, what,
-                   duration(seconds).c_str(), duration(eta).c_str());
+                   duration(seconds).c_str(), eta.c_str());
     }
   };
 }
