@@ -86,21 +86,9 @@ std::array<std::vector<double>, 2> bounding_box(const TensorSpline<P>& s, int co
   int n = 1;
   for (int d = 0; d < P; ++d) n *= orders[static_cast<std::size_t>(d)];
   for (int e = 0; e < total; ++e) {
-    std::array<int, P> el{};
-    int rest = e;
-    for (int d = 0; d < P; ++d) {
-      const auto dd = static_cast<std::size_t>(d);
-      el[dd] = rest % spans[dd];
-      rest /= spans[dd];
-    }
+    const auto el = detail::piece_element<P>(e, spans);
     for (int r = 0; r < n; ++r) {
-      std::array<int, P> src{};
-      int q = r;
-      for (int d = 0; d < P; ++d) {
-        const auto dd = static_cast<std::size_t>(d);
-        src[dd] = el[dd] * orders[dd] + q % orders[dd];
-        q /= orders[dd];
-      }
+      const auto src = detail::piece_point<P>(el, r, orders);
       const auto p = b.point(b.row(src));
       for (int h = 0; h < k; ++h) {
         const auto hh = static_cast<std::size_t>(h);

@@ -270,12 +270,7 @@ std::vector<TensorSpline<P>> bezier_pieces(const TensorSpline<P>& s) {
   out.reserve(static_cast<std::size_t>(total));
   const auto orders = b.orders();
   for (int e = 0; e < total; ++e) {
-    std::array<int, P> el{};
-    int rest = e;
-    for (int d = 0; d < P; ++d) {
-      el[static_cast<std::size_t>(d)] = rest % spans[static_cast<std::size_t>(d)];
-      rest /= spans[static_cast<std::size_t>(d)];
-    }
+    const auto el = detail::piece_element<P>(e, spans);
     std::array<KnotVector, P> knots;
     int n = 1;
     for (int d = 0; d < P; ++d) {
@@ -287,13 +282,7 @@ std::vector<TensorSpline<P>> bezier_pieces(const TensorSpline<P>& s) {
     std::vector<double> pts(static_cast<std::size_t>(n * s.dim()));
     std::vector<double> w(b.rational() ? static_cast<std::size_t>(n) : 0);
     for (int r = 0; r < n; ++r) {
-      std::array<int, P> src{};
-      int q = r;
-      for (int d = 0; d < P; ++d) {
-        const auto dd = static_cast<std::size_t>(d);
-        src[dd] = el[dd] * orders[dd] + q % orders[dd];  // Bezier form: `order` points per span
-        q /= orders[dd];
-      }
+      const auto src = detail::piece_point<P>(el, r, orders);
       const int sr = b.row(src);
       std::copy_n(b.point(sr).data(), s.dim(), pts.data() + static_cast<std::ptrdiff_t>(r) * s.dim());
       if (b.rational()) w[static_cast<std::size_t>(r)] = b.weights()[static_cast<std::size_t>(sr)];

@@ -89,4 +89,27 @@ std::vector<double> span_samples(const KnotVector& kv, int k);
 /// smooth of the two there: the space of sums (order = max) or of products (order = o_a + o_b - 1).
 KnotVector merged_space(const KnotVector& a, const KnotVector& b, int order);
 
+/// The Bezier pieces of a spline in Bezier form along every direction (each interior knot at full
+/// multiplicity): piece e (u fastest) spans element el = piece_element(e, spans) of the
+/// breakpoint grid, and its local control point r (u fastest) is the net's point
+/// piece_point(el, r, orders): disjoint blocks of `order` points per span and direction.
+template <int P>
+std::array<int, P> piece_element(int e, const std::array<int, P>& spans) {
+  std::array<int, P> el{};
+  for (std::size_t d = 0; d < P; ++d) {
+    el[d] = e % spans[d];
+    e /= spans[d];
+  }
+  return el;
+}
+template <int P>
+std::array<int, P> piece_point(const std::array<int, P>& el, int r, const std::array<int, P>& orders) {
+  std::array<int, P> src{};
+  for (std::size_t d = 0; d < P; ++d) {
+    src[d] = el[d] * orders[d] + r % orders[d];
+    r /= orders[d];
+  }
+  return src;
+}
+
 }  // namespace trivox::spline::detail
