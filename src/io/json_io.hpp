@@ -109,7 +109,8 @@ private:
 /// this is the same DOM as one parse; it is taken only when every piece parses (then the whole is
 /// valid: the pieces joined by commas inside their brackets) and the top-level keys are plain
 /// and distinct. Otherwise nothing: the caller parses the whole (and reports its errors).
-inline std::optional<json> parse_split(std::string_view text) {
+/// @param big  the arrays split: those spanning at least this many bytes
+inline std::optional<json> parse_split(std::string_view text, std::size_t big = std::size_t{1} << 20) {
   struct Member {
     std::string key;
     std::size_t open = 0, close = 0;             // the array's brackets
@@ -201,7 +202,6 @@ inline std::optional<json> parse_split(std::string_view text) {
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return std::nullopt;
   // Split only the big arrays; an empty one ("[]", one blank item) stays in the rest.
-  constexpr std::size_t big = std::size_t{1} << 20;
   std::erase_if(members, [&](const Member& m) {
     return m.close - m.open < big || (m.items.size() == 1 && text.substr(m.items[0].first, m.items[0].second - m.items[0].first)
                                                                      .find_first_not_of(" \t\n\r") == std::string_view::npos);
