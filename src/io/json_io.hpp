@@ -122,6 +122,7 @@ inline std::optional<json> parse_split(std::string_view text, std::size_t big = 
   bool in_string = false, top_seen = false, expect_key = false;
   std::size_t string_start = 0, item_start = 0;
   Member* current = nullptr;  // the big array being split (depth 2 inside it)
+  std::vector<char> opened;   // the open brackets and braces, innermost last
   std::string last_key;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const char c = text[i];
@@ -175,10 +176,14 @@ inline std::optional<json> parse_split(std::string_view text, std::size_t big = 
           current = &members.back();
           item_start = i + 1;
         }
+        opened.push_back(c2);
         ++depth;
         break;
       case '}':
       case ']':
+        // Brackets must match (else the document is not JSON, and the spans would be nonsense).
+        if (opened.empty() || opened.back() != (c2 == '}' ? '{' : '[')) return std::nullopt;
+        opened.pop_back();
         if (depth == 2 && current && c2 == ']') {
           current->items.emplace_back(item_start, i);
           current->close = i;
