@@ -255,7 +255,9 @@ TEST_CASE("locate: points next to a degenerate rail are placed, not failed") {
 }
 
 TEST_CASE("locate: a point just off the filleted teapot's rail is placed outside") {
-  // A piece of the built teapot's handle_fillet.1b (u in [0.77, 0.776], 11 KB): its face v = 1 is
+  // A piece of the built teapot's handle_fillet.1b (u in [0.77, 0.776], 11 KB; cut from
+  // `trivox build models/teapot.json` with spline::restrict_to(volume, 0, 0.77, 0.776) and
+  // io::save_model, the model's properties kept): its face v = 1 is
   // the rail, a curve. The voxel centre below lies 0.0093 mm from the rail, outside the cell;
   // with the sampler's options at J750 pitches, one level of subdivision left it undecided (the
   // slice's one inversion failure).
