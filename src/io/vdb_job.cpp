@@ -445,7 +445,11 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               const std::int32_t c = s.count[v];
               if (c == 0) continue;
               const double* acc = s.sums.data() + v * static_cast<std::size_t>(channels);
-              for (int h = 0; h < channels; ++h) mean[static_cast<std::size_t>(h)] = static_cast<float>(acc[h] / c);
+              // One sample (every voxel without supersampling): its value, as acc / 1 would give.
+              if (c == 1)
+                for (int h = 0; h < channels; ++h) mean[static_cast<std::size_t>(h)] = static_cast<float>(acc[h]);
+              else
+                for (int h = 0; h < channels; ++h) mean[static_cast<std::size_t>(h)] = static_cast<float>(acc[h] / c);
               const float density = static_cast<float>(c) * inv_n3;
               const openvdb::Index off = FloatLeaf::coordToOffset(openvdb::Coord(i, j, k0 + k));
               dl->setValueOn(off, density);
