@@ -71,14 +71,13 @@ io::SliceProgress make_progress(const std::string& mode, const char* unit = "lay
     const std::string eta = done == total ? duration(0.0)
                             : measured   ? duration(span * (total - done) / (done - st->base_done))
                                          : std::string("--");
-    auto* last = &st->last;
     if (bar) {
       const int width = 30, fill = total ? done * width / total : width;
       std::fprintf(stderr, "\r[%.*s%.*s] %d/%d %s, %.3g %s/s, ETA %s   ", fill, "##############################",
                    width - fill, "..............................", done, total, unit, rate, what, eta.c_str());
       if (done == total) std::fprintf(stderr, "\n");
-    } else if (seconds - *last >= 5.0 || done == total) {
-      *last = seconds;
+    } else if (seconds - st->last >= 5.0 || done == total) {
+      st->last = seconds;
       std::fprintf(stderr, "trivox slice: %d/%d %s, %.3g %s/s, elapsed %s, ETA %s\n", done, total, unit, rate, what,
                    duration(seconds).c_str(), eta.c_str());
     }

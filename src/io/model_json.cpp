@@ -7,9 +7,9 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <map>
 #include <optional>
-#include <exception>
 #include <nlohmann/json.hpp>
 
 #include "json_io.hpp"

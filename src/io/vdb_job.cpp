@@ -654,7 +654,7 @@ void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
                     ") differs from " + parts[0].string() + " (" + into->getName() + ", " + into->type() +
                     "); expected parts of one job");
       // The parts hold disjoint whole leaves (shards are whole 8-layer blocks): merging moves
-      // them, as the job itself merges its tasks' trees.
+      // them into the first part's trees.
       if (instance) continue;
       if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(into)) {
         f->tree().merge(openvdb::gridPtrCast<openvdb::FloatGrid>(from)->tree());

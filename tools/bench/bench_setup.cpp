@@ -6,8 +6,6 @@
 // REPEATS runs (default 1).
 //
 // Usage: trivox_bench_setup [MODEL [REPEATS]]
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
