@@ -139,12 +139,13 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
 namespace {
 /// The model's box and the profile's grid over it (model_bounds once: a thousand-span cell's
 /// Bezier form takes seconds).
-std::pair<std::array<slice::Vec3, 2>, slice::VoxelGrid> box_and_grid(const vmodel::VModel& model,
-                                                                    const slice::PrintProfile& profile) {
+std::pair<std::array<slice::Vec3, 2>, slice::VoxelGrid> box_and_grid(
+    const vmodel::VModel& model, const slice::PrintProfile& profile,
+    const std::optional<std::array<slice::Vec3, 2>>& known = std::nullopt) {
   if (model.cells.empty())
     throw Error("the model has no cells; expected at least one volumetric cell to slice");
   check_profile(profile);
-  const auto box = slice::model_bounds(model);
+  const auto box = known ? *known : slice::model_bounds(model);
   return {box, slice::VoxelGrid::covering(box[0], box[1], {profile.pitch_x(), profile.pitch_y(), profile.pitch_z()})};
 }
 }  // namespace
@@ -155,7 +156,7 @@ slice::VoxelGrid slice_grid(const vmodel::VModel& model, const slice::PrintProfi
 
 SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions& opt, const SliceProgress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto box_grid = box_and_grid(model, opt.profile);
+  const auto box_grid = box_and_grid(model, opt.profile, opt.model_box);
   const auto& box = box_grid.first;
   const slice::VoxelGrid& grid = box_grid.second;
 

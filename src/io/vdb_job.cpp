@@ -273,13 +273,17 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
     throw Error("--vdb-voxel " + num(*opt.voxel_mm) + ": not a positive size; expected a voxel edge in mm, above 0");
   VdbPlan plan;
   plan.supersample = opt.supersample;
-  const auto box = slice::model_bounds(model);
+  const auto box = opt.model_box ? *opt.model_box : slice::model_bounds(model);
   plan.origin = box[0];
 
-  std::vector<double> volumes(model.cells.size());
-  tbb::parallel_for(std::size_t{0}, model.cells.size(),
-                    [&](std::size_t i) { volumes[i] = std::abs(geom::signed_volume(model.cells[i].volume)); });
-  for (double v : volumes) plan.estimated_volume_mm3 += v;
+  if (opt.model_volume_mm3) {
+    plan.estimated_volume_mm3 = *opt.model_volume_mm3;
+  } else {
+    std::vector<double> volumes(model.cells.size());
+    tbb::parallel_for(std::size_t{0}, model.cells.size(),
+                      [&](std::size_t i) { volumes[i] = std::abs(geom::signed_volume(model.cells[i].volume)); });
+    for (double v : volumes) plan.estimated_volume_mm3 += v;
+  }
 
   std::array<double, 3> extent{};
   double box_volume = 1.0;

@@ -204,6 +204,10 @@ PY
 "$trivox" slice models/graded_block.json -o "$tmp/g1" --png --vdb --dpi 25.4,25.4 --layer 1 --vdb-voxel 1 --threads 1 $q --json > "$tmp/g1.json"
 "$trivox" slice models/graded_block.json -o "$tmp/g2" --vdb --vdb-voxel 1 --threads 2 $q > /dev/null
 cmp "$tmp/g1/graded_block.vdb" "$tmp/g2/graded_block.vdb"
+# The PNG stack written with the VDB (the model's box measured once for both jobs) is the stack
+# written alone.
+"$trivox" slice models/graded_block.json -o "$tmp/g3" --dpi 25.4,25.4 --layer 1 --threads 2 $q > /dev/null
+for f in "$tmp"/g3/slice_*.png "$tmp/g3/ConfigFile.xml"; do cmp "$f" "$tmp/g1/$(basename "$f")"; done
 [ -f "$tmp/g1/ConfigFile.xml" ] && [ -f "$tmp/g1/slice_00000.png" ]
 "$py" - "$tmp/g1" <<'PY'
 import sys, json, hashlib, os

@@ -42,6 +42,9 @@ struct SliceJobOptions {
   std::int64_t max_voxels = 100'000'000'000;   ///< refuse larger grids unless force
   int band_rows = 64;                          ///< rows sampled and dithered at a time
   slice::SamplerOptions sampler;               ///< sampling options (the Shepard blend, --blend)
+  /// slice::model_bounds(model), when the caller has it already (a job that also writes a VDB):
+  /// saves computing it again (0.4 s on the filleted teapot). Empty: computed here.
+  std::optional<std::array<slice::Vec3, 2>> model_box;
 
   // The manifest (manifest.hpp): what identifies the job, resuming, sharding.
   std::string model_file;                      ///< the model file's name, as given

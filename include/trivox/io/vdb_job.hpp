@@ -66,6 +66,12 @@ struct VdbJobOptions {
   std::optional<std::array<int, 2>> layer_range;
   std::string file_name;              ///< the file's name in out_dir; empty: <model stem>.vdb
   slice::SamplerOptions sampler;      ///< sampling options (the Shepard blend, --blend)
+  /// What plan_vdb_job measures on the model, when the caller has it already (a PNG job's box,
+  /// an earlier plan's volume): slice::model_bounds(model) and the sum of the cells' |volume|
+  /// (VdbPlan::estimated_volume_mm3). Each saves its computation (on the filleted teapot 0.4 s and
+  /// 0.5 s); empty: computed.
+  std::optional<std::array<slice::Vec3, 2>> model_box;
+  std::optional<double> model_volume_mm3;
 };
 
 /// The grid a VDB job will use, found before anything is written.
