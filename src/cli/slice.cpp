@@ -3,7 +3,6 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
-#include <array>
 #include <charconv>
 #include <cstdio>
 #include <memory>
@@ -16,7 +15,6 @@
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_job.hpp"
 #include "trivox/io/vdb_job.hpp"
-#include "trivox/slice/locator.hpp"
 #include "trivox/version.hpp"
 
 namespace trivox::cli {
@@ -200,12 +198,7 @@ void add_slice(CLI::App& app, Common& common) {
     io::VdbJobOptions vj;
     vj.sampler = sampling;
     std::optional<io::VdbPlan> plan;
-    // The VDB's plans (and the PNG job, when both are written) need the model's box: computed
-    // once here (an empty model is left to the jobs, which report it).
-    std::optional<std::array<slice::Vec3, 2>> box;
-    if (want_vdb && !model.cells.empty()) box = slice::model_bounds(model);
     if (want_vdb) {
-      vj.model_box = box;
       vj.out_dir = opt->out;
       vj.model_file = opt->model;
       if (!opt->palette.empty()) vj.palette = opt->palette;
@@ -214,7 +207,9 @@ void add_slice(CLI::App& app, Common& common) {
       vj.force = opt->force;
       vj.require_empty_folder = !want_png;
       plan = io::plan_vdb_job(model, vj);  // bad VDB options fail before the PNG stack is written
-      vj.model_volume_mm3 = plan->estimated_volume_mm3;  // and the later plans reuse its measures
+      // The later plans, and the PNG job, reuse its measures of the model.
+      vj.model_box = plan->model_box;
+      vj.model_volume_mm3 = plan->estimated_volume_mm3;
       if (shard.count > 1) {  // this shard's whole leaves, in a part of its own
         vj.layer_range = shard.range(plan->count[2]);
         vj.file_name = shard.part_name(plan->file.filename().string());
@@ -308,7 +303,7 @@ void add_slice(CLI::App& app, Common& common) {
     job.resume = opt->resume;
     job.shard = shard;
     job.sampler = sampling;
-    job.model_box = box;
+    if (plan) job.model_box = plan->model_box;
     const std::optional<io::ManifestFile> vdb_done = verified_vdb();
     const auto s = io::run_slice_job(model, job, make_progress(opt->progress));
     std::optional<io::VdbJobSummary> v;

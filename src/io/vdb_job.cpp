@@ -275,6 +275,7 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
   plan.supersample = opt.supersample;
   const auto box = opt.model_box ? *opt.model_box : slice::model_bounds(model);
   plan.origin = box[0];
+  plan.model_box = box;
 
   if (opt.model_volume_mm3) {
     plan.estimated_volume_mm3 = *opt.model_volume_mm3;

@@ -66,10 +66,10 @@ struct VdbJobOptions {
   std::optional<std::array<int, 2>> layer_range;
   std::string file_name;              ///< the file's name in out_dir; empty: <model stem>.vdb
   slice::SamplerOptions sampler;      ///< sampling options (the Shepard blend, --blend)
-  /// What plan_vdb_job measures on the model, when the caller has it already (a PNG job's box,
-  /// an earlier plan's volume): slice::model_bounds(model) and the sum of the cells' |volume|
-  /// (VdbPlan::estimated_volume_mm3). Each saves its computation (on the filleted teapot 0.4 s and
-  /// 0.5 s); empty: computed.
+  /// What plan_vdb_job measures on the model, when an earlier plan has it already
+  /// (VdbPlan::model_box and estimated_volume_mm3): slice::model_bounds(model) and the sum of the
+  /// cells' |volume|. Each saves its computation (on the filleted teapot 0.4 s and 0.5 s); empty:
+  /// computed.
   std::optional<std::array<slice::Vec3, 2>> model_box;
   std::optional<double> model_volume_mm3;
 };
@@ -80,6 +80,7 @@ struct VdbPlan {
   bool automatic = false;                ///< the voxel size was chosen from the volume
   int supersample = 1;
   std::array<double, 3> origin{};        ///< minimum corner of the model's bounding box, mm
+  std::array<std::array<double, 3>, 2> model_box{};  ///< the model's bounding box (model_bounds), mm
   std::array<int, 3> count{};            ///< voxels of the dense box along x, y, z
   std::int64_t dense_voxels = 0;         ///< count[0] * count[1] * count[2]
   double estimated_volume_mm3 = 0.0;     ///< sum of |cell volume| by Gauss quadrature (trivox info)
