@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <numeric>
@@ -245,6 +247,103 @@ Kernels pick_kernels(const std::array<int, 3>& ord, int nc) {
   if (is(4, 4, 2)) return kernels_for<4, 4, 2, H>(nc);
   if (is(2, 2, 4)) return kernels_for<2, 2, 4, H>(nc);
   return kernels_for<0, 0, 0, H>(nc);
+}
+
+/// Eight doubles as one vector (GCC and Clang vector extensions: two AVX registers, one AVX-512
+/// register, four SSE registers; the same IEEE operations lane by lane on every target).
+using V8d = double __attribute__((vector_size(64)));
+
+/// bernstein<O>'s recurrence on eight parameters at once (values only).
+template <int O>
+[[gnu::always_inline]] inline void bernstein8(int order, V8d s, V8d* B) {
+  const int n = O ? O : order;
+  const V8d one = V8d{} + 1.0;
+  if (n == 1) {
+    B[0] = one;
+    return;
+  }
+  const V8d s1 = one - s;
+  V8d b[O ? O : max_order];
+  b[0] = one;
+  for (int k = 1; k < n - 1; ++k) {
+    b[k] = s * b[k - 1];
+    for (int j = k - 1; j >= 1; --j) b[j] = s1 * b[j] + s * b[j - 1];
+    b[0] *= s1;
+  }
+  B[n - 1] = s * b[n - 2];
+  for (int j = n - 2; j >= 1; --j) B[j] = s1 * b[j] + s * b[j - 1];
+  B[0] = s1 * b[0];
+}
+
+/// Properties (coordinates H .. H + m - 1 of an nc-coordinate polynomial net) at eight points at
+/// once, one lane per point: s holds the points' local parameters (s[d][lane], not clamped), out
+/// the values (out[lane * m + h]). Contracts u, then v, then w, every step one multiply-add of
+/// eight lanes; each lane's floats are those of the same operations in the same order, whatever
+/// the vector width. OU, OV, OW as geom_kernel's.
+template <int OU, int OV, int OW>
+[[gnu::always_inline]] inline void props8_body(const double* net, int nc, int H, int m, const std::array<int, 3>& ord,
+                                               const double (*s)[8], double* out) {
+  constexpr int MU = OU ? OU : max_order, MV = OV ? OV : max_order, MW = OW ? OW : max_order;
+  const int ou = OU ? OU : ord[0], ov = OV ? OV : ord[1], ow = OW ? OW : ord[2];
+  V8d su, sv, sw;
+  std::memcpy(&su, s[0], sizeof su);
+  std::memcpy(&sv, s[1], sizeof sv);
+  std::memcpy(&sw, s[2], sizeof sw);
+  V8d Bu[MU], Bv[MV], Bw[MW];
+  bernstein8<OU>(ou, su, Bu);
+  bernstein8<OV>(ov, sv, Bv);
+  bernstein8<OW>(ow, sw, Bw);
+  for (int h = 0; h < m; ++h) {
+    V8d S = {};
+    for (int c = 0; c < ow; ++c) {
+      V8d T = {};
+      for (int b = 0; b < ov; ++b) {
+        const double* row = net + static_cast<std::ptrdiff_t>((c * ov + b) * ou) * nc + H + h;
+        V8d r = Bu[0] * row[0];
+        for (int a = 1; a < ou; ++a) r += Bu[a] * row[a * nc];
+        T += Bv[b] * r;
+      }
+      S += Bw[c] * T;
+    }
+    double v[8];
+    std::memcpy(v, &S, sizeof v);
+    for (int l = 0; l < 8; ++l) out[l * m + h] = v[l];
+  }
+}
+
+using Props8 = void (*)(const double*, int, int, int, const std::array<int, 3>&, const double (*)[8], double*);
+
+template <int OU, int OV, int OW>
+void props8(const double* net, int nc, int H, int m, const std::array<int, 3>& ord, const double (*s)[8], double* out) {
+  props8_body<OU, OV, OW>(net, nc, H, m, ord, s, out);
+}
+template <int OU, int OV, int OW>
+[[gnu::target("avx2")]] void props8_avx2(const double* net, int nc, int H, int m, const std::array<int, 3>& ord,
+                                         const double (*s)[8], double* out) {
+  props8_body<OU, OV, OW>(net, nc, H, m, ord, s, out);
+}
+template <int OU, int OV, int OW>
+[[gnu::target("avx512f")]] void props8_avx512(const double* net, int nc, int H, int m, const std::array<int, 3>& ord,
+                                              const double (*s)[8], double* out) {
+  props8_body<OU, OV, OW>(net, nc, H, m, ord, s, out);
+}
+
+/// props8 with the orders fixed at compile time for the common pieces (pick_kernels' list), for
+/// the widest vectors the CPU has.
+template <int OU, int OV, int OW>
+Props8 props8_for() {
+  static const bool avx512 = __builtin_cpu_supports("avx512f") && !std::getenv("TRIVOX_NO_AVX512");
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx512 ? props8_avx512<OU, OV, OW> : avx2 ? props8_avx2<OU, OV, OW> : props8<OU, OV, OW>;
+}
+Props8 pick_props8(const std::array<int, 3>& ord) {
+  const auto is = [&](int a, int b, int c) { return ord[0] == a && ord[1] == b && ord[2] == c; };
+  if (is(4, 4, 4)) return props8_for<4, 4, 4>();
+  if (is(4, 4, 2)) return props8_for<4, 4, 2>();
+  if (is(2, 2, 4)) return props8_for<2, 2, 4>();
+  if (is(3, 3, 3)) return props8_for<3, 3, 3>();
+  if (is(2, 2, 2)) return props8_for<2, 2, 2>();
+  return props8_for<0, 0, 0>();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1464,6 +1563,37 @@ bool Locator::expand(int cell, const Vec3& t, Expansion& out) const {
     for (std::size_t d = 0; d < 3; ++d) out.grad[uh][d] = f[static_cast<std::size_t>(nc) * (d + 1) + 3 + uh] * pc.inv_len[d];
   }
   return true;
+}
+
+void Locator::piece_properties(int piece, const Vec3* t, int n, double* out) const {
+  const Data& D = *data_;
+  const auto& pc = D.pieces[static_cast<std::size_t>(piece)];
+  if (D.m == 0 || n <= 0) return;
+  if (pc.H != 3) {  // rational: not one polynomial; each point evaluated (clamped) instead
+    Scratch buf(pc.nc);
+    double x[3];
+    for (int j = 0; j < n; ++j) D.eval_all(pc, t[j], buf.data(), x, out + static_cast<std::size_t>(j) * static_cast<std::size_t>(D.m));
+    return;
+  }
+  const Props8 kernel = pick_props8(pc.order);
+  const double* net = D.pool.data() + pc.net;
+  const auto um = static_cast<std::size_t>(D.m);
+  double s[3][8], buf[8 * Expansion::max_props];
+  std::vector<double> heap;
+  double* vals = buf;
+  if (D.m > Expansion::max_props) {
+    heap.resize(8 * um);
+    vals = heap.data();
+  }
+  for (int j0 = 0; j0 < n; j0 += 8) {
+    const int k = std::min(8, n - j0);
+    for (int l = 0; l < 8; ++l) {
+      const Vec3& p = t[j0 + std::min(l, k - 1)];  // spare lanes repeat the last point
+      for (std::size_t d = 0; d < 3; ++d) s[d][l] = (p[d] - pc.lo[d]) * pc.inv_len[d];
+    }
+    kernel(net, pc.nc, pc.H, D.m, pc.order, s, vals);
+    std::copy_n(vals, static_cast<std::size_t>(k) * um, out + static_cast<std::size_t>(j0) * um);
+  }
 }
 
 const StepBounds& Locator::step_bounds(int piece) const noexcept {

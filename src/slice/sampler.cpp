@@ -86,11 +86,16 @@ struct RowLeaf {
 constexpr int block_rows = LayerSampler::block_rows;
 
 /// Certified first-order stepping from an anchor (an Expansion at voxel (ia, la) of a block):
-/// voxel (ia + k, la + l) gets t = t0 + J0^-1 (p - X0) = t0 + c0 + k dx + l dy and properties
-/// P0 + G0 (t - t0), accepted only when rigorous bounds show (Newton-Kantorovich, in Deuflhard's
-/// affine-covariant form, see AnchorMaker::certified) that the exact preimage t* of its centre
-/// lies within r of t inside the anchor's piece (or outside it by less than the tolerance) and
-/// that the properties are within 0.95/512 of P(t*). The bounds use the piece's bounds on second
+/// voxel (ia + k, la + l) gets t = t0 + J0^-1 (p - X0) = t0 + c0 + k dx + l dy, accepted only
+/// when rigorous bounds show (Newton-Kantorovich, in Deuflhard's affine-covariant form, see
+/// AnchorMaker::certified) that the exact preimage t* of its centre lies within r of t inside the
+/// anchor's piece (or outside it by less than the tolerance) and that its properties are within
+/// 0.95/512 of P(t*). With properties (Anchor::step > 0), the piece's own polynomial is evaluated
+/// exactly at the t of every `step`-th voxel of a run and interpolated linearly in between: the
+/// error is the gradient times |t* - t| (at most half the budget, from the certificate) plus the
+/// interpolation's step^2 / 8 max |d^2 P / dk^2| (the rest; the second partials' bounds seen
+/// along dx). So an anchor's rectangle is limited by the geometry and the piece alone, not by
+/// how fast the properties vary, as a first-order property model P0 + G0 (t - t0) would be. The bounds use the piece's bounds on second
 /// partials (StepBounds). Bounding |t_j - t0_j| by |c0_j| + |k| |dx_j| + |l| |dy_j| makes every
 /// bound grow with |k| and |l|, and the margin to the piece's box is affine in (k, l), so
 /// certifying the extreme |k|, |l| and the four corners certifies a whole rectangle: found once
@@ -99,7 +104,9 @@ struct Anchor {
   int ia = 0, la = 0;                 ///< voxel column and block row of the expansion
   std::array<int, block_rows> lo{}, hi{};  ///< certified columns per block row (lo > hi: none)
   Vec3 tb{}, dx{}, dy{};              ///< t(k, l) = tb + k dx + l dy
-  std::array<double, Expansion::max_props> pb{}, pdx{}, pdy{};  ///< P(k, l) likewise
+  int piece = -1;                     ///< the expansion's piece
+  std::array<double, Expansion::max_props> pb{}, pdx{}, pdy{};  ///< P(k, l) likewise (step 0)
+  int step = 0;                       ///< properties exact every step columns (0: P(k, l))
 
   bool covers(int l, int i) const { return lo[static_cast<std::size_t>(l)] <= i && i <= hi[static_cast<std::size_t>(l)]; }
   Vec3 at(int l, int i) const {
@@ -151,6 +158,17 @@ public:
     gmax_ = {0.0, 0.0, 0.0};
     for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h)
       for (std::size_t d = 0; d < 3; ++d) gmax_[d] = std::max(gmax_[d], std::abs(e.grad[h][d]));
+    a.piece = e.piece;
+    a.step = 0;
+    for (std::size_t j = 0; j < 3; ++j) {
+      // box_cap's terms: the room between t0 + c0 and the box grown by tol / slope.
+      const double base = e.t[j] + c0_[j];
+      const bool bounded = a.dx[j] != 0.0 && b_->slope[j] > 0.0;
+      const double reach = bounded ? tol_ / b_->slope[j] : 0.0;
+      room_hi_[j] = b_->hi[j] + reach - base;
+      room_lo_[j] = base - (b_->lo[j] - reach);
+      inv_dx_[j] = bounded ? 1.0 / std::abs(a.dx[j]) : 0.0;
+    }
     for (std::size_t j = 0; j < 3; ++j) a.tb[j] = e.t[j] + c0_[j];
     for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h) {
       a.pb[h] = e.props[h] + e.grad[h][0] * c0_[0] + e.grad[h][1] * c0_[1] + e.grad[h][2] * c0_[2];
@@ -164,29 +182,36 @@ public:
     // covering most voxels wins.
     int best_up = 0, best_down = 0, best_k = -1, best_kn = 0;
     long best_area = 0;
+    Errors best_err;
     auto consider = [&](int opt) {
       const int up = opt == 0 ? l : opt == 1 ? std::min(l, 1) : 0;
       const int down = opt == 0 ? rows_ - 1 - l : opt == 1 ? std::min(rows_ - 1 - l, 1) : 0;
       const bool both_ways = opt < 2;
       const auto uo = static_cast<std::size_t>(opt);
-      const int K = largest([&](int k) { return certified(both_ways ? k : 0, k, up, down); }, guess_[uo]);
+      const int cap = box_cap(both_ways ? -1 : 0, up, down);
+      const int K = largest([&](int k) { return certified(both_ways ? k : 0, k, up, down); }, guess_[uo], cap, capped_[uo]);
       if (K < 0) return;
       guess_[uo] = K;
+      capped_[uo] = K == cap;
       const long area = static_cast<long>(both_ways ? 2 * K + 1 : K + 1) * (up + down + 1);
       if (area > best_area) {
         best_area = area;
         best_up = up, best_down = down, best_k = K, best_kn = both_ways ? K : 0;
+        best_err = err_;  // the search's last success is its K
       }
     };
     if (shift > 0) {
       const int up = l, down = rows_ - 1 - l;
-      const int K = largest([&](int k) { return certified(shift, k, up, down); }, guess_[0]);
+      const int cap = box_cap(shift, up, down);
+      const int K = largest([&](int k) { return certified(shift, k, up, down); }, guess_[0], cap, capped_[3]);
       if (K < 0) return false;
       guess_[0] = K;
+      capped_[3] = K == cap;
       for (int r = 0; r < rows_; ++r) {
         a.lo[static_cast<std::size_t>(r)] = std::max(0, i - shift);
         a.hi[static_cast<std::size_t>(r)] = std::min(nx_ - 1, i + K);
       }
+      a.step = sample_step(err_);
       return true;
     }
     // The whole block first; the narrower shapes only when it spans few columns.
@@ -200,18 +225,65 @@ public:
       a.lo[static_cast<std::size_t>(r)] = std::max(0, i - best_kn);
       a.hi[static_cast<std::size_t>(r)] = std::min(nx_ - 1, i + best_k);
     }
+    a.step = sample_step(best_err);
     return true;
   }
 
 private:
-  /// The largest k in [0, nx] with ok(k) (ok is monotone: true up to some k), or -1; tries a
-  /// little more than `guess` first (neighbouring anchors are alike).
+  /// The property errors of a certified rectangle (certified_with): the gradient term and the
+  /// first-order model's Taylor remainder.
+  struct Errors {
+    double grad = 0.0, taylor = 0.0;
+  };
+
+  /// How a certified rectangle with errors `err` gets its properties (Anchor's comment): 0, the
+  /// first-order model, when its remainder fits the budget too (no evaluations); else the spacing
+  /// of exact evaluations along its rows, the largest s with s^2 / 8 Q2 within the budget the
+  /// gradient term leaves, Q2 bounding |d^2 P / dk^2| = |dx^T (d^2 P / dt^2) dx| by the part's
+  /// second-partial bounds (times the 1.01 of a certificate reaching out of the part).
+  int sample_step(const Errors& err) const {
+    if (m_ == 0 || err.grad + err.taylor <= prop_budget) return 0;
+    const double grad = err.grad;
+    const auto& P = b_->p2;
+    double q2 = 0.0;
+    for (std::size_t d = 0; d < 3; ++d)
+      for (std::size_t f = 0; f < 3; ++f) q2 += std::abs(dx_[d]) * std::abs(dx_[f]) * P[d][f];
+    q2 *= 1.01;
+    const double room = prop_budget - grad;
+    const double s = q2 > 0.0 ? std::floor(std::sqrt(8.0 * room / q2)) : static_cast<double>(nx_);
+    return static_cast<int>(std::clamp(s, 1.0, static_cast<double>(std::max(nx_, 1))));
+  }
+
+  /// The largest k for which the rectangle of columns -kn .. k (kn < 0: -k .. k) and rows -ln ..
+  /// lp keeps its linear-model parameters inside the bounds' box grown by the certificate's
+  /// reach out of it (tol / slope per direction; at most nx, at least 0): no larger k is
+  /// certified, and where the box binds (a cell's face, the part's edge) it is the anchor's
+  /// width, found without a search (room_lo_, room_hi_, inv_dx_ from make()).
+  int box_cap(int kn, int ln, int lp) const {
+    double cap = nx_;
+    for (std::size_t j = 0; j < 3; ++j) {
+      if (!(inv_dx_[j] > 0.0)) continue;
+      const double ya = -ln * dy_[j], yb = lp * dy_[j];
+      const double up = room_hi_[j] - std::max(ya, yb), down = room_lo_[j] + std::min(ya, yb);
+      if (kn < 0)
+        cap = std::min(cap, std::min(up, down) * inv_dx_[j]);
+      else
+        cap = std::min(cap, (dx_[j] > 0.0 ? up : down) * inv_dx_[j]);
+    }
+    return cap >= 1.0 ? static_cast<int>(std::floor(cap)) : 0;  // NaN: 0
+  }
+
+  /// The largest k in [0, cap] with ok(k) (ok is monotone: true up to some k), or -1: a little
+  /// more than `guess` first (neighbouring anchors are alike), and then cap itself when the last
+  /// anchor of its kind reached its cap (`cap_first`: the box binds there); else doubling and
+  /// bisection.
   template <class F>
-  int largest(F&& ok, int guess) const {
-    const int limit = nx_;
+  int largest(F&& ok, int guess, int cap, bool cap_first) const {
+    const int limit = std::min(cap, nx_);
+    guess = std::min(guess, limit);
     if (guess > 0) {
       const int more = std::min(limit, guess + guess / 4 + 1);
-      if (ok(more)) return more;
+      if (ok(more)) return cap_first && more < limit && ok(limit) ? limit : more;
       if (ok(guess)) return guess;
     }
     if (!ok(0)) return -1;
@@ -302,16 +374,20 @@ private:
     }
     // |P(t*) - model| <= Taylor remainder + sum_d (largest dP/dt_d near t) |t*_d - t_d|, plus,
     // for t* outside the box, the change to the cell's nearest parameters.
+    // The properties: the first-order model within the budget (its Taylor remainder and the
+    // gradient term), or else exact at t up to the interpolation between samples (sample_step),
+    // which gets the budget the gradient term leaves; that term may take at most half of it.
     const auto& P = b_->p2;
     double grad_term = 0.0;
     for (std::size_t d = 0; d < 3; ++d) {
       const double g = gmax_[d] + G * (P[d][0] * (a[0] + r[0]) + P[d][1] * (a[1] + r[1]) + P[d][2] * (a[2] + r[2]));
       grad_term += g * (r[d] + out[d]);
     }
-    const double perr = G * (0.5 * (P[0][0] * a[0] * a[0] + P[1][1] * a[1] * a[1] + P[2][2] * a[2] * a[2]) +
-                             P[0][1] * a[0] * a[1] + P[0][2] * a[0] * a[2] + P[1][2] * a[1] * a[2]) +
-                        grad_term;
-    return perr <= prop_budget ? 1 : 0;
+    const double taylor = G * (0.5 * (P[0][0] * a[0] * a[0] + P[1][1] * a[1] * a[1] + P[2][2] * a[2] * a[2]) +
+                               P[0][1] * a[0] * a[1] + P[0][2] * a[0] * a[2] + P[1][2] * a[1] * a[2]);
+    if (!(grad_term <= 0.5 * prop_budget || grad_term + taylor <= prop_budget)) return 0;
+    err_ = {grad_term, taylor};
+    return 1;
   }
 
   const Locator& loc_;
@@ -324,7 +400,10 @@ private:
   Vec3 gmax_{};                 ///< largest |dP_h/dt_d| at the anchor
   std::array<Vec3, 3> w_{};     ///< bounds on |J0^-1 d^2X/dt_d dt_e|
   double omega_ = 0.0;
+  Vec3 room_lo_{}, room_hi_{}, inv_dx_{};  ///< box_cap's terms (0 in inv_dx_: unbounded)
+  mutable Errors err_;          ///< the property errors of the last rectangle certified
   std::array<int, 3> guess_{-1, -1, -1};
+  std::array<bool, 4> capped_{};  ///< per kind (the three shapes, shifted), the last anchor reached its cap
 };
 
 /// A proof that points beyond a face of a cell are not in the leaves of one Bezier piece near
@@ -498,37 +577,45 @@ Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, 
   return Outcome::inside;
 }
 
-/// Fills voxels i0 .. i1 - 1 of block row l from anchor a (cell index, properties, uvw).
-/// M: properties known at compile time (-1: m).
+/// out[j m + h] = va[h] + j slope[h] for j < n, h < m (a run of voxels' properties from a linear
+/// model): four voxels' m values at a time, as one flat run of 4m floats (base + block * delta),
+/// which vectorises. M: m known at compile time (-1: m).
 template <int M>
-void fill_run(const Anchor& a, int l, int i0, int i1, int cell, std::int32_t* owner, float* props, double* uvw, int m) {
-  const int n = M >= 0 ? M : m;
-  const double dl = l - a.la;
-  double base[Expansion::max_props];
-  for (int h = 0; h < n; ++h) base[h] = a.pb[static_cast<std::size_t>(h)] + dl * a.pdy[static_cast<std::size_t>(h)];
-  for (int j = i0; j < i1; ++j) {
-    const double k = j - a.ia;
-    owner[j] = cell;
-    float* vp = props + static_cast<std::ptrdiff_t>(j) * n;
-    for (int h = 0; h < n; ++h) vp[h] = static_cast<float>(base[h] + k * a.pdx[static_cast<std::size_t>(h)]);
+void write_linear(float* out, int n, int m, const double* va, const double* slope) {
+  const int um = M >= 0 ? M : m;
+  if (n < 8) {  // short runs (curved cells, boundaries): no set-up
+    for (int j = 0; j < n; ++j)
+      for (int h = 0; h < um; ++h) out[j * um + h] = static_cast<float>(va[h] + j * slope[h]);
+    return;
   }
-  if (uvw)
-    for (int j = i0; j < i1; ++j) {
-      const Vec3 t = a.at(l, j);
-      std::copy(t.begin(), t.end(), uvw + static_cast<std::ptrdiff_t>(j) * 3);
+  constexpr int W = 4 * (M >= 0 ? M : Expansion::max_props);
+  double base[W > 0 ? W : 1], delta[W > 0 ? W : 1];
+  const int w = 4 * um;
+  for (int h = 0; h < um; ++h)
+    for (int v = 0; v < 4; ++v) {
+      base[v * um + h] = va[h] + v * slope[h];
+      delta[v * um + h] = 4.0 * slope[h];
     }
+  const int blocks = n / 4;
+  float* o = out;
+  for (int b = 0; b < blocks; ++b, o += w) {
+    const double fb = b;
+    for (int k = 0; k < w; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
+  }
+  const int rest = (n - 4 * blocks) * um;
+  const double fb = blocks;
+  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
 }
 
-using FillRun = void (*)(const Anchor&, int, int, int, int, std::int32_t*, float*, double*, int);
+using WriteLinear = void (*)(float*, int, int, const double*, const double*);
 
-FillRun pick_fill(int m) {
+WriteLinear pick_write(int m) {
   switch (m) {
-    case 0: return fill_run<0>;
-    case 1: return fill_run<1>;
-    case 2: return fill_run<2>;
-    case 3: return fill_run<3>;
-    case 4: return fill_run<4>;
-    default: return fill_run<-1>;
+    case 1: return write_linear<1>;
+    case 2: return write_linear<2>;
+    case 3: return write_linear<3>;
+    case 4: return write_linear<4>;
+    default: return write_linear<-1>;
   }
 }
 
@@ -545,7 +632,7 @@ struct BlockOut {
 class BlockSampler {
 public:
   BlockSampler(const Locator& loc, const VoxelGrid& grid)
-      : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())), fill_(pick_fill(m_)) {}
+      : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())), write_(pick_write(m_)) {}
 
   void run(int layer, int r0, int nr, BlockOut& out) {
     const int nx = grid_.count[0], ny = grid_.count[1];
@@ -650,7 +737,7 @@ private:
         const int iend = std::min(a.hi[ul], span_end);
         int j = i;
         while (j <= iend && owner[j] < 0) ++j;  // the run: certified and not taken
-        fill_(a, l, i, j, cell, owner, props, uvw, m_);
+        fill(a, l, i, j, cell, owner, props, uvw);
         out_->inverted[ul] += j - i;
         chain.n = 0;
         if (j > i) {
@@ -670,6 +757,47 @@ private:
             uvw ? uvw + static_cast<std::size_t>(i) * 3 : nullptr);
       ++i;
     }
+  }
+
+  /// Voxels i0 .. i1 - 1 of block row l from anchor a: cell index, uvw, and properties (Anchor's
+  /// comment): from the first-order model, or exact at the run's first and last voxels and every
+  /// a.step-th between and linear in between.
+  void fill(const Anchor& a, int l, int i0, int i1, int cell, std::int32_t* owner, float* props, double* uvw) {
+    const int n = i1 - i0;
+    if (n <= 0) return;
+    std::fill(owner + i0, owner + i1, cell);
+    if (uvw)
+      for (int j = i0; j < i1; ++j) {
+        const Vec3 t = a.at(l, j);
+        std::copy(t.begin(), t.end(), uvw + static_cast<std::ptrdiff_t>(j) * 3);
+      }
+    if (m_ == 0) return;
+    const auto um = static_cast<std::size_t>(m_);
+    float* out = props + static_cast<std::size_t>(i0) * um;
+    if (a.step == 0) {  // the first-order model
+      double va[Expansion::max_props];
+      const double k0 = i0 - a.ia, dl = l - a.la;
+      for (std::size_t h = 0; h < um; ++h) va[h] = a.pb[h] + k0 * a.pdx[h] + dl * a.pdy[h];
+      write_(out, n, m_, va, a.pdx.data());
+      return;
+    }
+    const int step = a.step;
+    const int count = n == 1 ? 1 : (n - 2) / step + 2;  // samples at 0, step, 2 step, ..., n - 1
+    pts_.resize(static_cast<std::size_t>(count));
+    vals_.resize(static_cast<std::size_t>(count) * um);
+    for (int q = 0; q < count; ++q) pts_[static_cast<std::size_t>(q)] = a.at(l, i0 + std::min(q * step, n - 1));
+    loc_.piece_properties(a.piece, pts_.data(), count, vals_.data());
+    for (int q = 0; q + 1 < count; ++q) {
+      const int ja = q * step, jb = std::min(ja + step, n - 1);
+      const double* va = vals_.data() + static_cast<std::size_t>(q) * um;
+      const double* vb = va + um;
+      const double inv = 1.0 / (jb - ja);
+      double slope[Expansion::max_props];
+      for (std::size_t h = 0; h < um; ++h) slope[h] = (vb[h] - va[h]) * inv;
+      write_(out + static_cast<std::size_t>(ja) * um, jb - ja, m_, va, slope);
+    }
+    const double* vl = vals_.data() + static_cast<std::size_t>(count - 1) * um;
+    for (std::size_t h = 0; h < um; ++h) out[static_cast<std::size_t>(n - 1) * um + h] = static_cast<float>(vl[h]);
   }
 
   /// One voxel off the stepping runs: an anchor at a prediction (its certification covers the
@@ -704,8 +832,14 @@ private:
       cur = static_cast<int>(anchors_.size()) - 1;
       if (!a.covers(l, i)) return false;
       const Vec3 t = a.at(l, i);
-      const double k = i - a.ia, dl = l - a.la;
-      for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h) vp[h] = static_cast<float>(a.pb[h] + k * a.pdx[h] + dl * a.pdy[h]);
+      if (a.step > 0) {
+        double v[Expansion::max_props];
+        loc_.piece_properties(a.piece, &t, 1, v);
+        for (int h = 0; h < m_; ++h) vp[h] = static_cast<float>(v[h]);
+      } else {
+        const double k = i - a.ia, dl = l - a.la;
+        for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h) vp[h] = static_cast<float>(a.pb[h] + k * a.pdx[h] + dl * a.pdy[h]);
+      }
       accept(t);
       return true;
     };
@@ -798,7 +932,7 @@ private:
   const Locator& loc_;
   const VoxelGrid& grid_;
   int m_;
-  FillRun fill_;
+  WriteLinear write_;
   BlockOut* out_ = nullptr;
   double tol_ = 0.0, z_ = 0.0;
   std::array<double, block_rows> y_{};
@@ -811,6 +945,8 @@ private:
   std::vector<int> cover_;
   AnchorMaker* maker_ = nullptr;
   Expansion exp_;
+  std::vector<Vec3> pts_;      ///< fill's sample points
+  std::vector<double> vals_;   ///< and their properties
 };
 
 }  // namespace

@@ -206,6 +206,51 @@ TEST_CASE("locate: expansions equal the spline's first partials, and step bounds
   CHECK_FALSE(lq.expand(0, {0.5, 0.5, 0.5}, e));
 }
 
+TEST_CASE("locate: a piece's properties at many points equal the spline's, also past the piece's box") {
+  // Orders (4, 4, 4) with two pieces per direction (a kernel with the orders at compile time)
+  // and (5, 4, 6) (the run-time orders); 1, 7, 8, 9 and 20 points (whole and partial groups of
+  // eight lanes).
+  auto a = curved_tricubic();
+  for (int d = 0; d < 3; ++d) a = spline::refine_uniform(a, d, 1);
+  auto b = spline::elevate(spline::elevate(curved_tricubic(), 0, 1), 2, 2);
+  for (const auto& cell : {a, b}) {
+    const auto m = model_of({cell}, {"r", "g", "b"});
+    const slice::Locator loc(m);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(0, 1);
+    for (int n : {1, 7, 8, 9, 20}) {
+      slice::Expansion e;
+      REQUIRE(loc.expand(0, {U(rng), U(rng), U(rng)}, e));
+      const auto& bd = loc.step_bounds(e.piece);
+      std::vector<Vec3> t(static_cast<std::size_t>(n));
+      for (auto& p : t)
+        for (std::size_t d = 0; d < 3; ++d) p[d] = bd.lo[d] + U(rng) * (bd.hi[d] - bd.lo[d]);
+      std::vector<double> v(static_cast<std::size_t>(n) * 3);
+      loc.piece_properties(e.piece, t.data(), n, v.data());
+      for (int j = 0; j < n; ++j) {
+        const auto x = cell.eval(t[static_cast<std::size_t>(j)]);
+        for (int h = 0; h < 3; ++h) CHECK(v[static_cast<std::size_t>(j * 3 + h)] == Approx(x[static_cast<std::size_t>(3 + h)]).margin(1e-12));
+      }
+    }
+  }
+  // Past its box a piece's polynomial continues (not clamped): `a` is one polynomial refined
+  // into pieces, so one piece's polynomial gives the spline's values over the whole domain.
+  const auto m = model_of({a}, {"r", "g", "b"});
+  const slice::Locator loc(m);
+  slice::Expansion e;
+  REQUIRE(loc.expand(0, {0.1, 0.1, 0.1}, e));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(0, 1);
+  std::vector<Vec3> t(40);
+  for (auto& p : t) p = {U(rng), U(rng), U(rng)};
+  std::vector<double> v(t.size() * 3);
+  loc.piece_properties(e.piece, t.data(), static_cast<int>(t.size()), v.data());
+  for (std::size_t j = 0; j < t.size(); ++j) {
+    const auto x = a.eval(t[j]);
+    for (std::size_t h = 0; h < 3; ++h) CHECK(v[j * 3 + h] == Approx(x[3 + h]).margin(1e-10));
+  }
+}
+
 TEST_CASE("locate: points next to a degenerate rail are placed, not failed") {
   // A fillet-like cusp, as the fillets' cells are next to their rails: cubic along the rail (u),
   // quadratic across (v), linear through (w), with the face v = 1 collapsed onto the rail, where

@@ -392,6 +392,13 @@ TEST_CASE("sampler: the contract holds at printer pitch for overlapping, rationa
     const LayerSampler s(m, thin_grid(m, 3), so);
     CHECK(check_contract(m, s, 1).inside > 20000);
   }
+  SECTION("the twisted column (the bench's model): its rows' properties from exact samples") {
+    // Nearly affine cells with cubic colour fields: the anchors reach across the cells, and
+    // their properties come from the piece's polynomial every few dozen voxels (sampler.cpp).
+    const auto m = io::load_model(models / "twisted_column.json");
+    const LayerSampler s(m, thin_grid(m, 2), so);
+    CHECK(check_contract(m, s, 3).inside > 300000);
+  }
   SECTION("rational quarter annulus") {
     const auto m = model_of({quarter_annulus(2, 4, 1)}, {"v"});
     const LayerSampler s(m, thin_grid(m, 2), so);

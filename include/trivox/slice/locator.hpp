@@ -262,6 +262,12 @@ public:
   /// @return false (nothing written) for a rational piece or more than Expansion::max_props
   ///         properties: then only the exact path applies
   bool expand(int cell, const Vec3& t, Expansion& out) const;
+  /// The m properties of Bezier piece `piece` (Expansion::piece) at the n parameter points t
+  /// (the cell's global parameters), out[j * m + h] for point j: the piece's own polynomial, not
+  /// clamped to its box, so that along a line of parameters the values are one polynomial (the
+  /// sampler interpolates it). Polynomial pieces only (those whose StepBounds are valid); points
+  /// are evaluated eight at a time, the same floats whatever the vector width.
+  void piece_properties(int piece, const Vec3* t, int n, double* out) const;
   /// The second-derivative bounds of a piece (Expansion::piece). Computed on first use
   /// (thread-safe; the values do not depend on the caller); the reference stays valid.
   const StepBounds& step_bounds(int piece) const noexcept;
