@@ -581,7 +581,7 @@ Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, 
 /// model): four voxels' m values at a time, as one flat run of 4m floats (base + block * delta),
 /// which vectorises. M: m known at compile time (-1: m).
 template <int M>
-void write_linear(float* out, int n, int m, const double* va, const double* slope) {
+[[gnu::always_inline]] inline void write_linear_body(float* out, int n, int m, const double* va, const double* slope) {
   const int um = M >= 0 ? M : m;
   if (n < 8) {  // short runs (curved cells, boundaries): no set-up
     for (int j = 0; j < n; ++j)
@@ -607,15 +607,36 @@ void write_linear(float* out, int n, int m, const double* va, const double* slop
   for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
 }
 
+template <int M>
+void write_linear(float* out, int n, int m, const double* va, const double* slope) {
+  write_linear_body<M>(out, n, m, va, slope);
+}
+#if defined(__x86_64__)
+/// The same operations on AVX registers (no contraction: the same floats).
+template <int M>
+[[gnu::target("avx2")]] void write_linear_avx2(float* out, int n, int m, const double* va, const double* slope) {
+  write_linear_body<M>(out, n, m, va, slope);
+}
+#endif
+
 using WriteLinear = void (*)(float*, int, int, const double*, const double*);
+
+template <int M>
+WriteLinear write_for() {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return write_linear_avx2<M>;
+#endif
+  return write_linear<M>;
+}
 
 WriteLinear pick_write(int m) {
   switch (m) {
-    case 1: return write_linear<1>;
-    case 2: return write_linear<2>;
-    case 3: return write_linear<3>;
-    case 4: return write_linear<4>;
-    default: return write_linear<-1>;
+    case 1: return write_for<1>();
+    case 2: return write_for<2>();
+    case 3: return write_for<3>();
+    case 4: return write_for<4>();
+    default: return write_for<-1>();
   }
 }
 

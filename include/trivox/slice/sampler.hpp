@@ -13,17 +13,27 @@
 /// - Certified stepping (polynomial cells with up to 7 properties): an *anchor* is one exact
 ///   evaluation at a voxel, of every coordinate with its first partials (Locator::expand). From
 ///   it the parameters of the voxels around it follow from the linear model,
-///   t = t0 + J0^-1 (p - X0), and their properties from P0 + G0 (t - t0). The piece's bounds on
-///   second partials (StepBounds) turn that into a certificate: a Taylor bound on
-///   |J0^-1 (X(t) - p)|, the Newton-Kantorovich theorem in its affine-covariant form (Deuflhard;
-///   so thin, sheared or layer-thin cells are as well served as cubes) for an exact preimage t*
-///   within a radius r of t inside the piece (so p is inside the cell; or outside the piece by
-///   less than the tolerance, where the contract allows either answer: a layer through a face
-///   between cells is certified too), and a bound on |model - P(t*)| below 0.95/512. All bounds
+///   t = t0 + J0^-1 (p - X0). The piece's bounds on second partials (StepBounds) turn that into
+///   a certificate: a Taylor bound on |J0^-1 (X(t) - p)|, the Newton-Kantorovich theorem in its
+///   affine-covariant form (Deuflhard; so thin, sheared or layer-thin cells are as well served as
+///   cubes) for an exact preimage t* within a radius r of t inside the piece (so p is inside the
+///   cell; or outside the piece by less than the tolerance, where the contract allows either
+///   answer: a layer through a face between cells is certified too), and a bound on the
+///   properties' error below 0.95/512. The properties come from the first-order model
+///   P0 + G0 (t - t0) where its Taylor remainder fits that budget; else from the piece's own
+///   polynomial, evaluated exactly at the t of every s-th voxel of a row (Locator::
+///   piece_properties) and interpolated linearly in between, the error being the gradient times
+///   |t* - t| (at most half the budget) plus s^2 / 8 times a bound on the second derivative
+///   along the row (the rest). So where the cells are nearly affine at voxel scale and the
+///   properties vary fast (the twisted column of models/: radii r about 1e-10), an anchor is
+///   limited by the piece and the cell's shape, not by its properties: hundreds of voxels
+///   instead of tens. All bounds
 ///   grow with the distance from the anchor, so an anchor certifies a rectangle of voxels across
-///   the block's rows at once (found by doubling and bisection on its width); inside it a voxel
-///   costs a few multiply-adds. The next anchor is placed ahead of the first voxel not yet
-///   covered, by the reach of the last one, so that rectangles do not overlap by half.
+///   the block's rows at once (its width found by doubling and bisection, up to where its
+///   parameters leave the piece's box, and that width tried first where the box bound the last
+///   anchor); inside it a voxel costs a few multiply-adds. The next anchor is placed ahead of the
+///   first voxel not yet covered, by the reach of the last one, so that rectangles do not
+///   overlap by half.
 /// - A voxel whose predicted parameters leave the cell's domain is first tried for a proof that
 ///   it is outside: one expansion at the face and a Taylor bound on where a root could lie,
 ///   over the piece's leaves that hold the voxel (without Newton; the proof also serves the next
@@ -37,7 +47,7 @@
 /// Accuracy (tests check it against a locator at tolerance 1e-10): occupancy equals the exact
 /// answer except for voxel centres within the tolerance (1e-3 of the smallest pitch) of a cell
 /// boundary; properties are within 1/512 of the cell's properties at the exact preimage of the
-/// voxel's centre (certified voxels: by the bound above; evaluated voxels: exact at a (u,v,w)
+/// voxel's centre (certified voxels: by the bounds above; evaluated voxels: exact at a (u,v,w)
 /// whose image lies within the tolerance of the centre). The (u,v,w) kept with
 /// SamplerOptions::keep_uvw map within the tolerance of the centre for evaluated voxels and within
 /// half the smallest pitch for certified ones (their exact preimage being within the certified
@@ -56,7 +66,8 @@
 /// count give identical output.
 ///
 /// Cost: per voxel inside a cell a few multiply-adds where certified, about one evaluation
-/// (O(order^3 * (3 + m))) per anchor (tens of voxels each at printer pitch), a few Newton
+/// (O(order^3 * (3 + m))) per anchor (tens to hundreds of voxels each at printer pitch) and one
+/// of the m properties (O(order^3 * m), eight points per vector pass) per sample, a few Newton
 /// iterations per voxel near boundaries; per row a pass over the leaves that meet the block;
 /// void voxels outside every leaf region cost nothing. No allocation per voxel.
 #pragma once
