@@ -229,6 +229,7 @@ void add_slice(CLI::App& app, Common& common) {
       vdb_options["vdb.supersample"] = std::to_string(plan->supersample);
     }
     const std::string model_sha = io::sha256_file(opt->model);
+    vj.model_sha256 = model_sha;  // the VDB's metadata: hashed once
     // A resumed job keeps its VDB when the manifest lists it and it verifies.
     auto verified_vdb = [&]() -> std::optional<io::ManifestFile> {
       if (want_vdb && opt->resume)

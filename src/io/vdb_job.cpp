@@ -339,7 +339,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
   const slice::MaterialMapper mapper(palette, model.properties);
   const Layout layout = make_layout(model, palette);
-  const std::string model_sha = opt.model_file.empty() ? std::string() : sha256_file(opt.model_file);
+  const std::string model_sha =
+      !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : sha256_file(opt.model_file);
   prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
   openvdb::initialize();
 

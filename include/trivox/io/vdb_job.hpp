@@ -72,6 +72,9 @@ struct VdbJobOptions {
   /// computed.
   std::optional<std::array<slice::Vec3, 2>> model_box;
   std::optional<double> model_volume_mm3;
+  /// The SHA-256 of model_file's bytes (hex), when the caller has it already (`trivox slice`
+  /// hashes the model once for its manifest); empty: computed from model_file.
+  std::string model_sha256;
 };
 
 /// The grid a VDB job will use, found before anything is written.
