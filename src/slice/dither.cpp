@@ -17,6 +17,25 @@ namespace trivox::slice {
 
 namespace {
 
+/// Flush-to-zero and denormals-are-zero for the floats of one dithering call, restored after
+/// it. The error carried for a material a region does not hold is never chosen away: it spreads
+/// over ever more voxels and decays towards subnormal floats, each of which costs an x86 core a
+/// microcode assist per operation (the error-diffusion kernel of a one-layer job ran 2.4 times
+/// slower on them). Flushed, such errors are 0 instead of below 1.2e-38, which no choice can
+/// notice; every path of the fs arithmetic runs under this guard, so they agree bit for bit.
+class FlushDenormals {
+public:
+#if defined(__x86_64__) && defined(__GNUC__)
+  FlushDenormals() noexcept : saved_(_mm_getcsr()) { _mm_setcsr(saved_ | 0x8040u); }  // FTZ | DAZ
+  ~FlushDenormals() { _mm_setcsr(saved_); }
+  FlushDenormals(const FlushDenormals&) = delete;
+  FlushDenormals& operator=(const FlushDenormals&) = delete;
+
+private:
+  unsigned saved_;
+#endif
+};
+
 /// splitmix64's step and finaliser (Steele, Lea & Flood 2014): a bijective 64-bit mix with full
 /// avalanche, so that neighbouring voxels' keys give unrelated numbers.
 inline std::uint64_t mix64(std::uint64_t z) noexcept {
@@ -793,6 +812,7 @@ void LayerDitherer::begin_layer(int layer) {
 }
 
 void LayerDitherer::dither(int row0, int rows, const std::int32_t* cell, const float* fractions, std::uint8_t* out) {
+  const FlushDenormals flush;
   if (rows <= 0) return;
   if (row0 < 0)
     throw Error("dithering layer " + std::to_string(layer_) + ": row " + std::to_string(row0) +
@@ -834,6 +854,7 @@ void LayerDitherer::fs_row(int row, const std::int32_t* cell, const float* fract
 
 void LayerDitherer::dither_paint(int row, const std::int32_t* cell, const float* props, const MaterialMapper& mapper,
                                  const std::array<std::uint32_t, 256>& colours, std::uint8_t* rgba, std::int64_t* counts) {
+  const FlushDenormals flush;
   if (mapper.materials() != materials_)
     throw Error("dithering: a mapper of " + std::to_string(mapper.materials()) + " materials for a ditherer of " +
                     std::to_string(materials_) + "; expected the same palette",
@@ -939,6 +960,7 @@ void LayerGroupDitherer::begin(int layers) {
 void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
                                       const std::array<std::uint32_t, 256>& colours, std::uint8_t* const* rgba,
                                       std::int64_t* const* counts) {
+  const FlushDenormals flush;
   if (layers_ < 1) throw Error("dithering: dither_paint before begin()", ErrorKind::failed);
   if (row < 0 || row < next_row_)
     throw Error("dithering: row " + std::to_string(row) + " after rows up to " + std::to_string(next_row_ - 1) +

@@ -5,9 +5,10 @@
 
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -487,4 +488,41 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
   std::swap(moved.materials[0], moved.materials[5]);
   CHECK_FALSE(LayerGroupDitherer::serves(DitherMode::fs, MaterialMapper(moved, names)));
   CHECK_FALSE(LayerGroupDitherer::serves(DitherMode::stochastic, mapper));
+}
+
+TEST_CASE("fs: dithering leaves the caller's floating-point mode as it found it", "[dither]") {
+  // The fs paths flush subnormal floats while they run (dither.cpp, FlushDenormals); the rest
+  // of the program must still see them. A product below the smallest normal float is
+  // subnormal, not 0, after each kind of call.
+  const std::vector<std::string> names = {"r", "g", "b"};
+  const MaterialMapper mapper(default_palette(), names);
+  const int nx = 16, nm = mapper.materials();
+  std::vector<std::int32_t> cell(nx, 0);
+  std::vector<float> props(static_cast<std::size_t>(nx) * 3, 0.25f);
+  std::vector<float> fractions(static_cast<std::size_t>(nx * nm), 1.0f / static_cast<float>(nm));
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(nx) * 4), idx(nx);
+  std::vector<std::int64_t> counts(static_cast<std::size_t>(nm), 0);
+  std::array<std::uint32_t, 256> colours{};
+  volatile float tiny = std::numeric_limits<float>::min();
+  auto subnormal_survives = [&] {
+    const float h = tiny * 0.25f;
+    return h != 0.0f && std::fpclassify(h) == FP_SUBNORMAL;
+  };
+  REQUIRE(subnormal_survives());
+  LayerDitherer d(DitherMode::fs, nx, nm, 0.0423, 0.0847);
+  d.begin_layer(0);
+  d.dither(0, 1, cell.data(), fractions.data(), idx.data());
+  CHECK(subnormal_survives());
+  d.dither_paint(1, cell.data(), props.data(), mapper, colours, rgba.data(), counts.data());
+  CHECK(subnormal_survives());
+  if (LayerGroupDitherer::serves(DitherMode::fs, mapper)) {
+    LayerGroupDitherer g(nx, mapper, 0.0423, 0.0847);
+    g.begin(1);
+    const std::int32_t* c[1] = {cell.data()};
+    const float* p[1] = {props.data()};
+    std::uint8_t* o[1] = {rgba.data()};
+    std::int64_t* k[1] = {counts.data()};
+    g.dither_paint(0, c, p, colours, o, k);
+    CHECK(subnormal_survives());
+  }
 }
