@@ -756,8 +756,14 @@ private:
       if (cur >= 0 && anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
         const Anchor& a = anchors_[static_cast<std::size_t>(cur)];
         const int iend = std::min(a.hi[ul], span_end);
+        // The run: certified and not taken (by an earlier cell), eight voxels at a time.
         int j = i;
-        while (j <= iend && owner[j] < 0) ++j;  // the run: certified and not taken
+        for (; j + 8 <= iend + 1; j += 8) {
+          int taken = 0;
+          for (int k = 0; k < 8; ++k) taken |= owner[j + k] >= 0;
+          if (taken) break;
+        }
+        while (j <= iend && owner[j] < 0) ++j;
         fill(a, l, i, j, cell, owner, props, uvw);
         out_->inverted[ul] += j - i;
         chain.n = 0;
