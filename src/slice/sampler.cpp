@@ -95,11 +95,13 @@ constexpr int block_rows = LayerSampler::block_rows;
 /// error is the gradient times |t* - t| (at most half the budget, from the certificate) plus the
 /// interpolation's step^2 / 8 max |d^2 P / dk^2| (the rest; the second partials' bounds seen
 /// along dx). So an anchor's rectangle is limited by the geometry and the piece alone, not by
-/// how fast the properties vary, as a first-order property model P0 + G0 (t - t0) would be. The bounds use the piece's bounds on second
-/// partials (StepBounds). Bounding |t_j - t0_j| by |c0_j| + |k| |dx_j| + |l| |dy_j| makes every
-/// bound grow with |k| and |l|, and the margin to the piece's box is affine in (k, l), so
-/// certifying the extreme |k|, |l| and the four corners certifies a whole rectangle: found once
-/// per anchor by doubling and bisection, after which a voxel costs a few multiply-adds.
+/// how fast the properties vary, as with the first-order property model P0 + G0 (t - t0), which
+/// is kept (step 0) where its Taylor remainder fits the budget. The bounds use the piece's
+/// bounds on second partials (StepBounds). Bounding |t_j - t0_j| by |c0_j| + |k| |dx_j| +
+/// |l| |dy_j| makes every bound grow with |k| and |l|, and the margin to the piece's box is
+/// affine in (k, l), so certifying the extreme |k|, |l| and the four corners certifies a whole
+/// rectangle: found once per anchor by doubling and bisection, after which a voxel costs a few
+/// multiply-adds.
 struct Anchor {
   int ia = 0, la = 0;                 ///< voxel column and block row of the expansion
   std::array<int, block_rows> lo{}, hi{};  ///< certified columns per block row (lo > hi: none)

@@ -265,8 +265,9 @@ public:
   /// The m properties of Bezier piece `piece` (Expansion::piece) at the n parameter points t
   /// (the cell's global parameters), out[j * m + h] for point j: the piece's own polynomial, not
   /// clamped to its box, so that along a line of parameters the values are one polynomial (the
-  /// sampler interpolates it). Polynomial pieces only (those whose StepBounds are valid); points
-  /// are evaluated eight at a time, the same floats whatever the vector width.
+  /// sampler interpolates it). Points are evaluated eight at a time, the same floats whatever
+  /// the vector width. A rational piece is not one polynomial: each point is then evaluated
+  /// clamped to the piece, its weight divided out (as eval()); the sampler never asks for one.
   void piece_properties(int piece, const Vec3* t, int n, double* out) const;
   /// The second-derivative bounds of a piece (Expansion::piece). Computed on first use
   /// (thread-safe; the values do not depend on the caller); the reference stays valid.
