@@ -705,9 +705,110 @@ struct GroupRow {
 
 using GroupKernel = void (*)(const GroupRow&);
 [[gnu::target("avx2")]] void group_kernel_avx2(const GroupRow& a) { group_kernel(a); }
-/// AVX-512VL: the same 8-lane code with 32 vector registers instead of 16 (the loop's state,
-/// 15 vectors, and its temporaries then stay in registers).
-[[gnu::target("avx2,avx512f,avx512vl")]] void group_kernel_avx512vl(const GroupRow& a) { group_kernel(a); }
+/// group_kernel with AVX-512VL's mask registers for the lanes' masks (live, forward neighbour,
+/// held materials, hits) and 32 vector registers: the same IEEE operations lane by lane (a
+/// masked subtract of 1 is the subtract of the 0 or 1 it replaces: v - 0 is v), so the same
+/// output, with masked moves in place of the AVX2 blends.
+[[gnu::target("avx2,avx512f,avx512vl")]] void group_kernel_avx512vl(const GroupRow& a) {
+  constexpr int K = group_k, S = group_stride;
+  const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  const int nx = a.nx, dir = a.left_to_right ? 1 : -1;
+  int x = a.left_to_right ? 0 : nx - 1;
+  const float* in = a.in + S;
+  float* down = a.down + S;
+  const std::int32_t* cell = a.cell + 8;
+  const float* props = a.props;
+  const std::ptrdiff_t np8 = 8 * static_cast<std::ptrdiff_t>(a.np);
+  const float* pr = props + 8 * a.ir;
+  const float* pg = props + 8 * a.ig;
+  const float* pb = props + 8 * a.ib;
+  std::int32_t* rgba = a.rgba;
+  const __m256i table = a.colours;
+  const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
+  __m256 acc_here[K], acc_fwd[K], carry[K];
+  for (int k = 0; k < K; ++k) acc_here[k] = acc_fwd[k] = carry[k] = zero;
+  // The counts: per material and lane, minus the sum of its hit masks (each hit is -1 as int32).
+  __m256i cnt[K];
+  for (int k = 0; k < K; ++k) cnt[k] = _mm256_setzero_si256();
+  // The weights of the first, middle and last columns (the forward neighbour's per lane).
+  const __m256* first_with = a.weights[nx > 1 ? has_forward | has_down_forward : 0];
+  const __m256* first_without = a.weights[nx > 1 ? has_down_forward : 0];
+  const __m256* mid_with = a.weights[has_forward | has_down_back | has_down_forward];
+  const __m256* mid_without = a.weights[has_down_back | has_down_forward];
+  const __m256* last_without = a.weights[nx > 1 ? has_down_back : 0];
+  for (int t = 0; t < nx; ++t, x += dir) {
+    const std::ptrdiff_t xs = x;
+    const float* e = in + xs * S;
+    float* d_back = down + (xs - dir) * S;
+    const __mmask8 live = _mm256_cmpgt_epi32_mask(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + xs * 8)), minus1);
+    if (live == 0) {
+      // Every layer void here: the error aimed here is dropped, none leaves.
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_setzero_si256());
+      for (int k = 0; k < K; ++k) {
+        _mm256_storeu_ps(d_back + 8 * k, acc_here[k]);
+        acc_here[k] = acc_fwd[k];
+        acc_fwd[k] = carry[k] = zero;
+      }
+      continue;
+    }
+    const bool last = t + 1 == nx;
+    // The forward neighbour's availability differs per layer (its voids); the rest does not.
+    const __mmask8 fwd = _mm256_cmpgt_epi32_mask(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + (xs + dir) * 8)), minus1);
+    const __m256* w_with = t == 0 ? first_with : last ? last_without : mid_with;
+    const __m256* w_without = t == 0 ? first_without : last ? last_without : mid_without;
+    __m256 w[4];
+    for (int j = 0; j < 4; ++j) w[j] = _mm256_mask_blend_ps(fwd, w_without[j], w_with[j]);
+
+    // cmykw_fractions, lane by lane: clamp (max(r, 0) is r > 0 ? r : 0, NaN -> 0; then min).
+    const std::ptrdiff_t at = xs * np8;
+    const __m256 r = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pr + at), zero), one);
+    const __m256 g = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pg + at), zero), one);
+    const __m256 b = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pb + at), zero), one);
+    const __m256 m = _mm256_max_ps(r, _mm256_max_ps(g, b));
+    const __m256 wh = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(r, g), b), _mm256_add_ps(m, m));
+    const __m256 s = _mm256_div_ps(one, _mm256_sub_ps(one, _mm256_min_ps(wh, zero)));
+    const __m256 f[K] = {_mm256_mul_ps(_mm256_sub_ps(m, r), s), _mm256_mul_ps(_mm256_sub_ps(m, g), s),
+                         _mm256_mul_ps(_mm256_sub_ps(m, b), s), _mm256_mul_ps(_mm256_sub_ps(one, m), s),
+                         _mm256_max_ps(wh, zero)};
+
+    // The candidates are the materials the voxel holds: masked = v where f > 0, else -3e38.
+    // (fs_kernel8 adds -3e38 to the others instead; either way they are far below the largest
+    // held value, which is the same float, and so are the choice and the ties.)
+    __m256 v[K], masked[K];
+    for (int k = 0; k < K; ++k) {
+      v[k] = _mm256_add_ps(_mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k)), carry[k]);
+      masked[k] = _mm256_mask_mov_ps(none, _mm256_cmp_ps_mask(f[k], zero, _CMP_GT_OQ), v[k]);
+    }
+    __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
+    mv = _mm256_max_ps(mv, masked[4]);
+    // The lowest material among equal maxima, in live lanes: eq_k and not any eq_j, j < k.
+    __mmask8 hit[K];
+    __mmask8 seen = _mm256_cmp_ps_mask(masked[0], mv, _CMP_EQ_OQ);
+    hit[0] = seen & live;
+    for (int k = 1; k < K; ++k) {
+      const __mmask8 eq = _mm256_cmp_ps_mask(masked[k], mv, _CMP_EQ_OQ);
+      hit[k] = static_cast<__mmask8>(~seen & eq & live);
+      seen = static_cast<__mmask8>(seen | eq);
+    }
+    __m256i idx = _mm256_maskz_mov_epi32(static_cast<__mmask8>(~live), seven);  // void: 7
+    for (int k = 1; k < K; ++k) idx = _mm256_mask_mov_epi32(idx, hit[k], _mm256_set1_epi32(k));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_permutevar8x32_epi32(table, idx));
+    for (int k = 0; k < K; ++k) {
+      cnt[k] = _mm256_mask_sub_epi32(cnt[k], hit[k], cnt[k], minus1);
+      // v - 1 where hit, v - 0 = v elsewhere; +0 in void lanes.
+      const __m256 err = _mm256_maskz_mov_ps(live, _mm256_mask_sub_ps(v[k], hit[k], v[k], one));
+      carry[k] = _mm256_mul_ps(w[0], err);
+      _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
+      acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
+      acc_fwd[k] = _mm256_mul_ps(w[3], err);
+    }
+  }
+  for (int k = 0; k < K; ++k) {
+    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x - dir) * S + 8 * k, acc_here[k]);
+    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x) * S + 8 * k, acc_fwd[k]);
+    a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_cvtepi32_ps(cnt[k]));
+  }
+}
 GroupKernel group_kernel_for() {
   static const bool avx512vl = __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512f");
   if (avx512vl && !std::getenv("TRIVOX_NO_AVX512")) return group_kernel_avx512vl;
