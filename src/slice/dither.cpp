@@ -589,6 +589,98 @@ struct GroupRow {
     for (int l = 0; l < lanes; ++l) std::memcpy(d[l] + j, s + j * 8 + static_cast<std::size_t>(l), 4);
 }
 
+/// What the two group kernels share: the row's pointers and weights, the state carried along the
+/// row (per material the error for the next voxel and the two accumulating in the next row), and
+/// the steps that do not depend on how the lanes' masks are held.
+struct GroupLoop {
+  static constexpr int K = group_k, S = group_stride;
+  const GroupRow& a;
+  int nx, dir, x;
+  const float* in;
+  float* down;
+  const std::int32_t* cell;
+  std::ptrdiff_t np8;
+  const float *pr, *pg, *pb;
+  // The weights of the first, middle and last columns (the forward neighbour's per lane).
+  const __m256 *first_with, *first_without, *mid_with, *mid_without, *last_without;
+  __m256 acc_here[K], acc_fwd[K], carry[K];
+  // The counts: per material and lane, the hits so far.
+  __m256i cnt[K];
+  const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
+
+  [[gnu::target("avx2"), gnu::always_inline]] explicit GroupLoop(const GroupRow& row)
+      : a(row), nx(row.nx), dir(row.left_to_right ? 1 : -1), x(row.left_to_right ? 0 : row.nx - 1), in(row.in + S),
+        down(row.down + S), cell(row.cell + 8), np8(8 * static_cast<std::ptrdiff_t>(row.np)), pr(row.props + 8 * row.ir),
+        pg(row.props + 8 * row.ig), pb(row.props + 8 * row.ib),
+        first_with(row.weights[row.nx > 1 ? has_forward | has_down_forward : 0]),
+        first_without(row.weights[row.nx > 1 ? has_down_forward : 0]),
+        mid_with(row.weights[has_forward | has_down_back | has_down_forward]),
+        mid_without(row.weights[has_down_back | has_down_forward]), last_without(row.weights[row.nx > 1 ? has_down_back : 0]) {
+    for (int k = 0; k < K; ++k) {
+      acc_here[k] = acc_fwd[k] = carry[k] = _mm256_setzero_ps();
+      cnt[k] = _mm256_setzero_si256();
+    }
+  }
+  /// Column xs's incoming errors, and where its down-back neighbour's go.
+  [[gnu::target("avx2"), gnu::always_inline]] const float* errors_in(std::ptrdiff_t xs, float*& d_back) const {
+    d_back = down + (xs - dir) * S;
+    return in + xs * S;
+  }
+  /// The layers' cell indices at column xs (lane l: layer l; -1 void).
+  [[gnu::target("avx2"), gnu::always_inline]] __m256i cells(std::ptrdiff_t xs) const {
+    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + xs * 8));
+  }
+  /// Column t's weights with and without its forward neighbour.
+  [[gnu::target("avx2"), gnu::always_inline]] void weights(int t, const __m256*& with, const __m256*& without) const {
+    const bool last = t + 1 == nx;
+    with = t == 0 ? first_with : last ? last_without : mid_with;
+    without = t == 0 ? first_without : last ? last_without : mid_without;
+  }
+  /// Every layer void at column xs: the error aimed here is dropped, none leaves.
+  [[gnu::target("avx2"), gnu::always_inline]] void void_column(std::ptrdiff_t xs, float* d_back) {
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_setzero_si256());
+    for (int k = 0; k < K; ++k) {
+      _mm256_storeu_ps(d_back + 8 * k, acc_here[k]);
+      acc_here[k] = acc_fwd[k];
+      acc_fwd[k] = carry[k] = _mm256_setzero_ps();
+    }
+  }
+  /// cmykw_fractions of column xs, lane by lane: clamp (max(r, 0) is r > 0 ? r : 0, NaN -> 0;
+  /// then min).
+  [[gnu::target("avx2"), gnu::always_inline]] void fractions(std::ptrdiff_t xs, __m256 (&f)[K]) const {
+    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+    const std::ptrdiff_t at = xs * np8;
+    const __m256 r = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pr + at), zero), one);
+    const __m256 g = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pg + at), zero), one);
+    const __m256 b = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pb + at), zero), one);
+    const __m256 m = _mm256_max_ps(r, _mm256_max_ps(g, b));
+    const __m256 wh = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(r, g), b), _mm256_add_ps(m, m));
+    const __m256 s = _mm256_div_ps(one, _mm256_sub_ps(one, _mm256_min_ps(wh, zero)));
+    f[0] = _mm256_mul_ps(_mm256_sub_ps(m, r), s);
+    f[1] = _mm256_mul_ps(_mm256_sub_ps(m, g), s);
+    f[2] = _mm256_mul_ps(_mm256_sub_ps(m, b), s);
+    f[3] = _mm256_mul_ps(_mm256_sub_ps(one, m), s);
+    f[4] = _mm256_max_ps(wh, zero);
+  }
+  /// Material k's error err at the column whose down-back neighbour is d_back, spread with the
+  /// column's weights w (forward, down-back, down, down-forward).
+  [[gnu::target("avx2"), gnu::always_inline]] void diffuse(int k, const __m256 (&w)[4], __m256 err, float* d_back) {
+    carry[k] = _mm256_mul_ps(w[0], err);
+    _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
+    acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
+    acc_fwd[k] = _mm256_mul_ps(w[3], err);
+  }
+  /// After the row: its last two columns' errors for the next row, and the counts.
+  [[gnu::target("avx2"), gnu::always_inline]] void finish() {
+    for (int k = 0; k < K; ++k) {
+      _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x - dir) * S + 8 * k, acc_here[k]);
+      _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x) * S + 8 * k, acc_fwd[k]);
+      a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_cvtepi32_ps(cnt[k]));
+    }
+  }
+};
+
 /// fs_kernel8 with the layers in the lanes (LayerGroupDitherer's comment): per colour material k
 /// one vector holds the eight layers' values, so that the choice is a vertical max and a
 /// compare, and void lanes are masked instead of branched over. The floats are fs_kernel8's
@@ -601,75 +693,35 @@ struct GroupRow {
 /// fs_kernel8 does to shorten its chain, measured no faster here: with eight layers per step the
 /// loop is bound by its vector instructions, not by its chain.)
 [[gnu::target("avx2"), gnu::always_inline]] inline void group_kernel(const GroupRow& a) {
-  constexpr int K = group_k, S = group_stride;
-  const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
-  const int nx = a.nx, dir = a.left_to_right ? 1 : -1;
-  int x = a.left_to_right ? 0 : nx - 1;
-  const float* in = a.in + S;
-  float* down = a.down + S;
-  const std::int32_t* cell = a.cell + 8;
-  const float* props = a.props;
-  const std::ptrdiff_t np8 = 8 * static_cast<std::ptrdiff_t>(a.np);
-  const float* pr = props + 8 * a.ir;
-  const float* pg = props + 8 * a.ig;
-  const float* pb = props + 8 * a.ib;
-  std::int32_t* rgba = a.rgba;
-  const __m256i table = a.colours;
-  const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
-  __m256 acc_here[K], acc_fwd[K], carry[K];
-  for (int k = 0; k < K; ++k) acc_here[k] = acc_fwd[k] = carry[k] = zero;
-  // The counts: per material and lane, minus the sum of its hit masks (each hit is -1 as int32).
-  __m256i cnt[K];
-  for (int k = 0; k < K; ++k) cnt[k] = _mm256_setzero_si256();
-  // The weights of the first, middle and last columns (the forward neighbour's per lane).
-  const __m256* first_with = a.weights[nx > 1 ? has_forward | has_down_forward : 0];
-  const __m256* first_without = a.weights[nx > 1 ? has_down_forward : 0];
-  const __m256* mid_with = a.weights[has_forward | has_down_back | has_down_forward];
-  const __m256* mid_without = a.weights[has_down_back | has_down_forward];
-  const __m256* last_without = a.weights[nx > 1 ? has_down_back : 0];
-  for (int t = 0; t < nx; ++t, x += dir) {
-    const std::ptrdiff_t xs = x;
-    const float* e = in + xs * S;
-    float* d_back = down + (xs - dir) * S;
-    const __m256i live_i = _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + xs * 8)), minus1);
+  constexpr int K = group_k;
+  GroupLoop g(a);
+  const __m256 none = g.none, one = g.one, zero = g.zero;
+  const __m256i seven = g.seven, minus1 = g.minus1;
+  for (int t = 0; t < g.nx; ++t, g.x += g.dir) {
+    const std::ptrdiff_t xs = g.x;
+    float* d_back;
+    const float* e = g.errors_in(xs, d_back);
+    const __m256i live_i = _mm256_cmpgt_epi32(g.cells(xs), minus1);
     if (_mm256_testz_si256(live_i, live_i)) {
-      // Every layer void here: the error aimed here is dropped, none leaves.
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_setzero_si256());
-      for (int k = 0; k < K; ++k) {
-        _mm256_storeu_ps(d_back + 8 * k, acc_here[k]);
-        acc_here[k] = acc_fwd[k];
-        acc_fwd[k] = carry[k] = zero;
-      }
+      g.void_column(xs, d_back);
       continue;
     }
     const __m256 live = _mm256_castsi256_ps(live_i);
-    const bool last = t + 1 == nx;
     // The forward neighbour's availability differs per layer (its voids); the rest does not.
-    const __m256 fwd = _mm256_castsi256_ps(
-        _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + (xs + dir) * 8)), minus1));
-    const __m256* w_with = t == 0 ? first_with : last ? last_without : mid_with;
-    const __m256* w_without = t == 0 ? first_without : last ? last_without : mid_without;
+    const __m256 fwd = _mm256_castsi256_ps(_mm256_cmpgt_epi32(g.cells(xs + g.dir), minus1));
+    const __m256 *w_with, *w_without;
+    g.weights(t, w_with, w_without);
     __m256 w[4];
     for (int j = 0; j < 4; ++j) w[j] = _mm256_blendv_ps(w_without[j], w_with[j], fwd);
-
-    // cmykw_fractions, lane by lane: clamp (max(r, 0) is r > 0 ? r : 0, NaN -> 0; then min).
-    const std::ptrdiff_t at = xs * np8;
-    const __m256 r = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pr + at), zero), one);
-    const __m256 g = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pg + at), zero), one);
-    const __m256 b = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pb + at), zero), one);
-    const __m256 m = _mm256_max_ps(r, _mm256_max_ps(g, b));
-    const __m256 wh = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(r, g), b), _mm256_add_ps(m, m));
-    const __m256 s = _mm256_div_ps(one, _mm256_sub_ps(one, _mm256_min_ps(wh, zero)));
-    const __m256 f[K] = {_mm256_mul_ps(_mm256_sub_ps(m, r), s), _mm256_mul_ps(_mm256_sub_ps(m, g), s),
-                         _mm256_mul_ps(_mm256_sub_ps(m, b), s), _mm256_mul_ps(_mm256_sub_ps(one, m), s),
-                         _mm256_max_ps(wh, zero)};
+    __m256 f[K];
+    g.fractions(xs, f);
 
     // The candidates are the materials the voxel holds: masked = v where f > 0, else -3e38.
     // (fs_kernel8 adds -3e38 to the others instead; either way they are far below the largest
     // held value, which is the same float, and so are the choice and the ties.)
     __m256 v[K], masked[K];
     for (int k = 0; k < K; ++k) {
-      v[k] = _mm256_add_ps(_mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k)), carry[k]);
+      v[k] = _mm256_add_ps(_mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k)), g.carry[k]);
       masked[k] = _mm256_blendv_ps(none, v[k], _mm256_cmp_ps(f[k], zero, _CMP_GT_OQ));
     }
     __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
@@ -685,22 +737,14 @@ struct GroupRow {
     }
     __m256i idx = _mm256_andnot_si256(_mm256_castps_si256(live), seven);  // void: 7
     for (int k = 1; k < K; ++k) idx = _mm256_or_si256(idx, _mm256_and_si256(_mm256_castps_si256(hit[k]), _mm256_set1_epi32(k)));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_permutevar8x32_epi32(table, idx));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_permutevar8x32_epi32(a.colours, idx));
     for (int k = 0; k < K; ++k) {
       const __m256 h = _mm256_and_ps(hit[k], one);
-      cnt[k] = _mm256_sub_epi32(cnt[k], _mm256_castps_si256(hit[k]));
-      const __m256 err = _mm256_and_ps(live, _mm256_sub_ps(v[k], h));  // +0 in void lanes
-      carry[k] = _mm256_mul_ps(w[0], err);
-      _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
-      acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
-      acc_fwd[k] = _mm256_mul_ps(w[3], err);
+      g.cnt[k] = _mm256_sub_epi32(g.cnt[k], _mm256_castps_si256(hit[k]));  // a hit is -1 as int32
+      g.diffuse(k, w, _mm256_and_ps(live, _mm256_sub_ps(v[k], h)), d_back);  // +0 in void lanes
     }
   }
-  for (int k = 0; k < K; ++k) {
-    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x - dir) * S + 8 * k, acc_here[k]);
-    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x) * S + 8 * k, acc_fwd[k]);
-    a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_cvtepi32_ps(cnt[k]));
-  }
+  g.finish();
 }
 
 using GroupKernel = void (*)(const GroupRow&);
@@ -710,78 +754,33 @@ using GroupKernel = void (*)(const GroupRow&);
 /// masked subtract of 1 is the subtract of the 0 or 1 it replaces: v - 0 is v), so the same
 /// output, with masked moves in place of the AVX2 blends.
 [[gnu::target("avx2,avx512f,avx512vl")]] void group_kernel_avx512vl(const GroupRow& a) {
-  constexpr int K = group_k, S = group_stride;
-  const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
-  const int nx = a.nx, dir = a.left_to_right ? 1 : -1;
-  int x = a.left_to_right ? 0 : nx - 1;
-  const float* in = a.in + S;
-  float* down = a.down + S;
-  const std::int32_t* cell = a.cell + 8;
-  const float* props = a.props;
-  const std::ptrdiff_t np8 = 8 * static_cast<std::ptrdiff_t>(a.np);
-  const float* pr = props + 8 * a.ir;
-  const float* pg = props + 8 * a.ig;
-  const float* pb = props + 8 * a.ib;
-  std::int32_t* rgba = a.rgba;
-  const __m256i table = a.colours;
-  const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
-  __m256 acc_here[K], acc_fwd[K], carry[K];
-  for (int k = 0; k < K; ++k) acc_here[k] = acc_fwd[k] = carry[k] = zero;
-  // The counts: per material and lane, minus the sum of its hit masks (each hit is -1 as int32).
-  __m256i cnt[K];
-  for (int k = 0; k < K; ++k) cnt[k] = _mm256_setzero_si256();
-  // The weights of the first, middle and last columns (the forward neighbour's per lane).
-  const __m256* first_with = a.weights[nx > 1 ? has_forward | has_down_forward : 0];
-  const __m256* first_without = a.weights[nx > 1 ? has_down_forward : 0];
-  const __m256* mid_with = a.weights[has_forward | has_down_back | has_down_forward];
-  const __m256* mid_without = a.weights[has_down_back | has_down_forward];
-  const __m256* last_without = a.weights[nx > 1 ? has_down_back : 0];
-  for (int t = 0; t < nx; ++t, x += dir) {
-    const std::ptrdiff_t xs = x;
-    const float* e = in + xs * S;
-    float* d_back = down + (xs - dir) * S;
-    const __mmask8 live = _mm256_cmpgt_epi32_mask(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + xs * 8)), minus1);
+  constexpr int K = group_k;
+  GroupLoop g(a);
+  const __m256 none = g.none, one = g.one, zero = g.zero;
+  const __m256i seven = g.seven, minus1 = g.minus1;
+  for (int t = 0; t < g.nx; ++t, g.x += g.dir) {
+    const std::ptrdiff_t xs = g.x;
+    float* d_back;
+    const float* e = g.errors_in(xs, d_back);
+    const __mmask8 live = _mm256_cmpgt_epi32_mask(g.cells(xs), minus1);
     if (live == 0) {
-      // Every layer void here: the error aimed here is dropped, none leaves.
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_setzero_si256());
-      for (int k = 0; k < K; ++k) {
-        _mm256_storeu_ps(d_back + 8 * k, acc_here[k]);
-        acc_here[k] = acc_fwd[k];
-        acc_fwd[k] = carry[k] = zero;
-      }
+      g.void_column(xs, d_back);
       continue;
     }
-    const bool last = t + 1 == nx;
-    // The forward neighbour's availability differs per layer (its voids); the rest does not.
-    const __mmask8 fwd = _mm256_cmpgt_epi32_mask(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(cell + (xs + dir) * 8)), minus1);
-    const __m256* w_with = t == 0 ? first_with : last ? last_without : mid_with;
-    const __m256* w_without = t == 0 ? first_without : last ? last_without : mid_without;
+    const __mmask8 fwd = _mm256_cmpgt_epi32_mask(g.cells(xs + g.dir), minus1);
+    const __m256 *w_with, *w_without;
+    g.weights(t, w_with, w_without);
     __m256 w[4];
     for (int j = 0; j < 4; ++j) w[j] = _mm256_mask_blend_ps(fwd, w_without[j], w_with[j]);
-
-    // cmykw_fractions, lane by lane: clamp (max(r, 0) is r > 0 ? r : 0, NaN -> 0; then min).
-    const std::ptrdiff_t at = xs * np8;
-    const __m256 r = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pr + at), zero), one);
-    const __m256 g = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pg + at), zero), one);
-    const __m256 b = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pb + at), zero), one);
-    const __m256 m = _mm256_max_ps(r, _mm256_max_ps(g, b));
-    const __m256 wh = _mm256_sub_ps(_mm256_add_ps(_mm256_add_ps(r, g), b), _mm256_add_ps(m, m));
-    const __m256 s = _mm256_div_ps(one, _mm256_sub_ps(one, _mm256_min_ps(wh, zero)));
-    const __m256 f[K] = {_mm256_mul_ps(_mm256_sub_ps(m, r), s), _mm256_mul_ps(_mm256_sub_ps(m, g), s),
-                         _mm256_mul_ps(_mm256_sub_ps(m, b), s), _mm256_mul_ps(_mm256_sub_ps(one, m), s),
-                         _mm256_max_ps(wh, zero)};
-
-    // The candidates are the materials the voxel holds: masked = v where f > 0, else -3e38.
-    // (fs_kernel8 adds -3e38 to the others instead; either way they are far below the largest
-    // held value, which is the same float, and so are the choice and the ties.)
+    __m256 f[K];
+    g.fractions(xs, f);
     __m256 v[K], masked[K];
     for (int k = 0; k < K; ++k) {
-      v[k] = _mm256_add_ps(_mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k)), carry[k]);
+      v[k] = _mm256_add_ps(_mm256_add_ps(f[k], _mm256_loadu_ps(e + 8 * k)), g.carry[k]);
       masked[k] = _mm256_mask_mov_ps(none, _mm256_cmp_ps_mask(f[k], zero, _CMP_GT_OQ), v[k]);
     }
     __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
     mv = _mm256_max_ps(mv, masked[4]);
-    // The lowest material among equal maxima, in live lanes: eq_k and not any eq_j, j < k.
     __mmask8 hit[K];
     __mmask8 seen = _mm256_cmp_ps_mask(masked[0], mv, _CMP_EQ_OQ);
     hit[0] = seen & live;
@@ -792,22 +791,14 @@ using GroupKernel = void (*)(const GroupRow&);
     }
     __m256i idx = _mm256_maskz_mov_epi32(static_cast<__mmask8>(~live), seven);  // void: 7
     for (int k = 1; k < K; ++k) idx = _mm256_mask_mov_epi32(idx, hit[k], _mm256_set1_epi32(k));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + xs * 8), _mm256_permutevar8x32_epi32(table, idx));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_permutevar8x32_epi32(a.colours, idx));
     for (int k = 0; k < K; ++k) {
-      cnt[k] = _mm256_mask_sub_epi32(cnt[k], hit[k], cnt[k], minus1);
+      g.cnt[k] = _mm256_mask_sub_epi32(g.cnt[k], hit[k], g.cnt[k], minus1);
       // v - 1 where hit, v - 0 = v elsewhere; +0 in void lanes.
-      const __m256 err = _mm256_maskz_mov_ps(live, _mm256_mask_sub_ps(v[k], hit[k], v[k], one));
-      carry[k] = _mm256_mul_ps(w[0], err);
-      _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
-      acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
-      acc_fwd[k] = _mm256_mul_ps(w[3], err);
+      g.diffuse(k, w, _mm256_maskz_mov_ps(live, _mm256_mask_sub_ps(v[k], hit[k], v[k], one)), d_back);
     }
   }
-  for (int k = 0; k < K; ++k) {
-    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x - dir) * S + 8 * k, acc_here[k]);
-    _mm256_storeu_ps(down + static_cast<std::ptrdiff_t>(x) * S + 8 * k, acc_fwd[k]);
-    a.counts[k] = _mm256_add_ps(a.counts[k], _mm256_cvtepi32_ps(cnt[k]));
-  }
+  g.finish();
 }
 GroupKernel group_kernel_for() {
   static const bool avx512vl = __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512f");
