@@ -14,16 +14,19 @@ for f in "$tmp"/f1/*; do cmp "$f" "$tmp/f2/$(basename "$f")"; done   # identical
 
 # A colour model takes the grouped dither (several layers per vector, LayerGroupDitherer): the
 # stack is the same with 1 and 2 threads and with every group cut to one layer (the single-layer
-# kernel), group sizes 3 and 5 (other lane fillings) and a layer range that splits the groups.
+# kernel), group sizes 3 and 5 (other lane fillings), a layer range that splits the groups, and
+# without the AVX-512 kernels (the sampler's property samples and the dither in AVX2 registers;
+# the same as the rest on a CPU without AVX-512).
 col=(--dpi 300,150 --layer 0.1 --progress never)
 "$trivox" slice models/twisted_column.json -o "$tmp/c8" "${col[@]}" --threads 2 > /dev/null
 "$trivox" slice models/twisted_column.json -o "$tmp/c8t1" "${col[@]}" --threads 1 > /dev/null
 TRIVOX_LAYER_GROUP=1 "$trivox" slice models/twisted_column.json -o "$tmp/c1" "${col[@]}" --threads 2 > /dev/null
 TRIVOX_LAYER_GROUP=3 "$trivox" slice models/twisted_column.json -o "$tmp/c3" "${col[@]}" --threads 2 > /dev/null
 TRIVOX_LAYER_GROUP=5 "$trivox" slice models/twisted_column.json -o "$tmp/c5" "${col[@]}" --threads 1 > /dev/null
+TRIVOX_NO_AVX512=1 "$trivox" slice models/twisted_column.json -o "$tmp/c2" "${col[@]}" --threads 2 > /dev/null
 "$trivox" slice models/twisted_column.json -o "$tmp/cs" "${col[@]}" --threads 2 --shard 1/3 > /dev/null
 [ "$(ls "$tmp/c8"/slice_*.png | wc -l)" -gt 20 ]
-for d in c8t1 c1 c3 c5; do
+for d in c8t1 c1 c3 c5 c2; do
   for f in "$tmp"/c8/slice_*.png "$tmp/c8/ConfigFile.xml"; do cmp "$f" "$tmp/$d/$(basename "$f")"; done
 done
 [ "$(ls "$tmp/cs"/slice_*.png | wc -l)" -gt 5 ]
