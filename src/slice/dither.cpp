@@ -649,7 +649,6 @@ struct GroupLoop {
   /// cmykw_fractions of column xs, lane by lane: clamp (max(r, 0) is r > 0 ? r : 0, NaN -> 0;
   /// then min).
   [[gnu::target("avx2"), gnu::always_inline]] void fractions(std::ptrdiff_t xs, __m256 (&f)[K]) const {
-    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
     const std::ptrdiff_t at = xs * np8;
     const __m256 r = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pr + at), zero), one);
     const __m256 g = _mm256_min_ps(_mm256_max_ps(_mm256_loadu_ps(pg + at), zero), one);

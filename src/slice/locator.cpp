@@ -15,6 +15,7 @@
 #include <mutex>
 #include <numeric>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "trivox/error.hpp"
@@ -35,17 +36,20 @@ constexpr double inf = std::numeric_limits<double>::infinity();
 // net of m coordinates (pre-multiplied by the weight when rational), so Newton never touches them.
 
 /// Bernstein polynomials of order n (degree n-1) at s and, when dB is not null, their derivatives.
-template <int O>
-inline void bernstein(int order, double s, double* B, double* dB) {
+/// T: double, or a vector of doubles (V8d below: several parameters at once, lane by lane the
+/// same operations).
+template <int O, class T = double>
+inline void bernstein(int order, T s, T* B, std::type_identity_t<T>* dB) {
   const int n = O ? O : order;
+  const T one = T{} + 1.0;
   if (n == 1) {
-    B[0] = 1.0;
-    if (dB) dB[0] = 0.0;
+    B[0] = one;
+    if (dB) dB[0] = T{};
     return;
   }
-  const double s1 = 1.0 - s;
-  double b[O ? O : max_order];  // degree n-2 values
-  b[0] = 1.0;
+  const T s1 = one - s;
+  T b[O ? O : max_order];  // degree n-2 values
+  b[0] = one;
   for (int k = 1; k < n - 1; ++k) {
     b[k] = s * b[k - 1];
     for (int j = k - 1; j >= 1; --j) b[j] = s1 * b[j] + s * b[j - 1];
@@ -215,65 +219,9 @@ Kernel first_o4_kernel() {
   return avx2 ? first_o4_avx2<NC> : first_o4<NC>;
 }
 
-struct Kernels {
-  Kernel first = nullptr;      ///< geometry with first partials
-  Kernel value = nullptr;      ///< geometry value
-  Kernel all = nullptr;        ///< every coordinate's value
-  Kernel all_first = nullptr;  ///< every coordinate with first partials (polynomial, nc <= 10)
-};
-
-template <int OU, int OV, int OW, int H>
-Kernels kernels_for(int nc) {
-  constexpr bool o4 = OU == 4 && OV == 4 && OW == 4;
-  Kernels k{geom_kernel<OU, OV, OW, H, true>, geom_kernel<OU, OV, OW, H, false>, value_kernel<OU, OV, OW, 0>, nullptr};
-  [&]<int... I>(std::integer_sequence<int, I...>) {
-    (((nc == I + 3) ? (k.all = value_kernel<OU, OV, OW, I + 3>,
-                       k.all_first = H != 3 ? nullptr : o4 ? first_o4_kernel<I + 3>() : geom_kernel<OU, OV, OW, I + 3, true, I + 3>, 0)
-                    : 0),
-     ...);
-  }(std::make_integer_sequence<int, 8>{});
-  return k;
-}
-
-/// Kernels with the orders fixed at compile time for the common pieces: uniform orders 2 to 4,
-/// and the shells and tubes the scenes build (cubic faces swept linearly, (4, 4, 2); linear
-/// sections swept along a cubic, (2, 2, 4)); any other orders read them at run time.
-template <int H>
-Kernels pick_kernels(const std::array<int, 3>& ord, int nc) {
-  const auto is = [&](int a, int b, int c) { return ord[0] == a && ord[1] == b && ord[2] == c; };
-  if (is(2, 2, 2)) return kernels_for<2, 2, 2, H>(nc);
-  if (is(3, 3, 3)) return kernels_for<3, 3, 3, H>(nc);
-  if (is(4, 4, 4)) return kernels_for<4, 4, 4, H>(nc);
-  if (is(4, 4, 2)) return kernels_for<4, 4, 2, H>(nc);
-  if (is(2, 2, 4)) return kernels_for<2, 2, 4, H>(nc);
-  return kernels_for<0, 0, 0, H>(nc);
-}
-
 /// Eight doubles as one vector (GCC and Clang vector extensions: two AVX registers, one AVX-512
 /// register, four SSE registers; the same IEEE operations lane by lane on every target).
 using V8d = double __attribute__((vector_size(64)));
-
-/// bernstein<O>'s recurrence on eight parameters at once (values only).
-template <int O>
-[[gnu::always_inline]] inline void bernstein8(int order, V8d s, V8d* B) {
-  const int n = O ? O : order;
-  const V8d one = V8d{} + 1.0;
-  if (n == 1) {
-    B[0] = one;
-    return;
-  }
-  const V8d s1 = one - s;
-  V8d b[O ? O : max_order];
-  b[0] = one;
-  for (int k = 1; k < n - 1; ++k) {
-    b[k] = s * b[k - 1];
-    for (int j = k - 1; j >= 1; --j) b[j] = s1 * b[j] + s * b[j - 1];
-    b[0] *= s1;
-  }
-  B[n - 1] = s * b[n - 2];
-  for (int j = n - 2; j >= 1; --j) B[j] = s1 * b[j] + s * b[j - 1];
-  B[0] = s1 * b[0];
-}
 
 /// Properties (coordinates H .. H + m - 1 of an nc-coordinate polynomial net) at eight points at
 /// once, one lane per point: s holds the points' local parameters (s[d][lane], not clamped), out
@@ -290,9 +238,9 @@ template <int OU, int OV, int OW>
   std::memcpy(&sv, s[1], sizeof sv);
   std::memcpy(&sw, s[2], sizeof sw);
   V8d Bu[MU], Bv[MV], Bw[MW];
-  bernstein8<OU>(ou, su, Bu);
-  bernstein8<OV>(ov, sv, Bv);
-  bernstein8<OW>(ow, sw, Bw);
+  bernstein<OU>(ou, su, Bu, nullptr);
+  bernstein<OV>(ov, sv, Bv, nullptr);
+  bernstein<OW>(ow, sw, Bw, nullptr);
   for (int h = 0; h < m; ++h) {
     V8d S = {};
     for (int c = 0; c < ow; ++c) {
@@ -328,22 +276,48 @@ template <int OU, int OV, int OW>
   props8_body<OU, OV, OW>(net, nc, H, m, ord, s, out);
 }
 
-/// props8 with the orders fixed at compile time for the common pieces (pick_kernels' list), for
-/// the widest vectors the CPU has.
+/// props8 for the widest vectors the CPU has.
 template <int OU, int OV, int OW>
 Props8 props8_for() {
   static const bool avx512 = __builtin_cpu_supports("avx512f") && !std::getenv("TRIVOX_NO_AVX512");
   static const bool avx2 = __builtin_cpu_supports("avx2");
   return avx512 ? props8_avx512<OU, OV, OW> : avx2 ? props8_avx2<OU, OV, OW> : props8<OU, OV, OW>;
 }
-Props8 pick_props8(const std::array<int, 3>& ord) {
+
+struct Kernels {
+  Kernel first = nullptr;      ///< geometry with first partials
+  Kernel value = nullptr;      ///< geometry value
+  Kernel all = nullptr;        ///< every coordinate's value
+  Kernel all_first = nullptr;  ///< every coordinate with first partials (polynomial, nc <= 10)
+  Props8 props = nullptr;      ///< the properties at eight points (polynomial)
+};
+
+template <int OU, int OV, int OW, int H>
+Kernels kernels_for(int nc) {
+  constexpr bool o4 = OU == 4 && OV == 4 && OW == 4;
+  Kernels k{geom_kernel<OU, OV, OW, H, true>, geom_kernel<OU, OV, OW, H, false>, value_kernel<OU, OV, OW, 0>, nullptr,
+            H == 3 ? props8_for<OU, OV, OW>() : nullptr};
+  [&]<int... I>(std::integer_sequence<int, I...>) {
+    (((nc == I + 3) ? (k.all = value_kernel<OU, OV, OW, I + 3>,
+                       k.all_first = H != 3 ? nullptr : o4 ? first_o4_kernel<I + 3>() : geom_kernel<OU, OV, OW, I + 3, true, I + 3>, 0)
+                    : 0),
+     ...);
+  }(std::make_integer_sequence<int, 8>{});
+  return k;
+}
+
+/// Kernels with the orders fixed at compile time for the common pieces: uniform orders 2 to 4,
+/// and the shells and tubes the scenes build (cubic faces swept linearly, (4, 4, 2); linear
+/// sections swept along a cubic, (2, 2, 4)); any other orders read them at run time.
+template <int H>
+Kernels pick_kernels(const std::array<int, 3>& ord, int nc) {
   const auto is = [&](int a, int b, int c) { return ord[0] == a && ord[1] == b && ord[2] == c; };
-  if (is(4, 4, 4)) return props8_for<4, 4, 4>();
-  if (is(4, 4, 2)) return props8_for<4, 4, 2>();
-  if (is(2, 2, 4)) return props8_for<2, 2, 4>();
-  if (is(3, 3, 3)) return props8_for<3, 3, 3>();
-  if (is(2, 2, 2)) return props8_for<2, 2, 2>();
-  return props8_for<0, 0, 0>();
+  if (is(2, 2, 2)) return kernels_for<2, 2, 2, H>(nc);
+  if (is(3, 3, 3)) return kernels_for<3, 3, 3, H>(nc);
+  if (is(4, 4, 4)) return kernels_for<4, 4, 4, H>(nc);
+  if (is(4, 4, 2)) return kernels_for<4, 4, 2, H>(nc);
+  if (is(2, 2, 4)) return kernels_for<2, 2, 4, H>(nc);
+  return kernels_for<0, 0, 0, H>(nc);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1575,7 +1549,7 @@ void Locator::piece_properties(int piece, const Vec3* t, int n, double* out) con
     for (int j = 0; j < n; ++j) D.eval_all(pc, t[j], buf.data(), x, out + static_cast<std::size_t>(j) * static_cast<std::size_t>(D.m));
     return;
   }
-  const Props8 kernel = pick_props8(pc.order);
+  const Props8 kernel = pc.k.props;
   const double* net = D.pool.data() + pc.net;
   const auto um = static_cast<std::size_t>(D.m);
   double s[3][8], buf[8 * Expansion::max_props];
