@@ -79,6 +79,9 @@ struct SliceJobSummary {
   /// (slice::LayerDitherer::dither_paint), timed together under dither; map and paint stay 0.
   /// Writing is the remainder. For benchmarks and `--json`; not part of any output file.
   std::array<double, 5> stage_seconds{};
+  /// Wall-clock seconds of the layers' pipeline alone: `seconds` less the setup before it and the
+  /// final sync, ConfigFile.xml and manifest after it (a sync's time varies with the disk).
+  double pipeline_seconds = 0.0;
   int layers_kept = 0;                   ///< layers a resumed job found done and verified
   std::array<int, 2> layer_range{};      ///< the layers this job (shard) covers, [first, end)
   Shard shard;
