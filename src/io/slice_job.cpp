@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <future>
 #include <map>
 #include <optional>
 #include <system_error>
@@ -248,6 +249,26 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   };
   write_manifest(false);
   auto last_manifest = Clock::now();
+  // The periodic manifest: its sync (which waits for the disk, seconds on a network share) runs
+  // on a thread of its own, so that no worker waits for it. It lists the layers written before
+  // it was taken; one at a time (a period whose predecessor is still syncing is skipped).
+  // std::async's future waits in its destructor, so an exception leaves no thread behind.
+  std::future<void> pending_manifest;
+  auto write_manifest_behind = [&] {
+    if (pending_manifest.valid()) {
+      if (pending_manifest.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+      pending_manifest.get();  // rethrows its error
+    }
+    Manifest snapshot = manifest;
+    snapshot.layers.clear();
+    for (const auto& [k, l] : finished) snapshot.layers.push_back(l);
+    snapshot.complete = false;
+    pending_manifest = std::async(std::launch::async, [snapshot = std::move(snapshot), dir = opt.out_dir] {
+      sync_folder_contents(dir);
+      write_file_atomically(dir / snapshot.shard.manifest_name(), manifest_json(snapshot));
+    });
+    last_manifest = Clock::now();
+  };
 
   tbb::enumerable_thread_specific<Scratch> scratch;
   int done = kept;
@@ -398,8 +419,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
               finished[out.layer] = ManifestLayer{out.layer, name, out.sha256, out.counts, out.failures};
               ++done;
               if (std::chrono::duration<double>(Clock::now() - last_manifest).count() >= opt.manifest_interval_s) {
-                write_manifest(false);
-                last_manifest = Clock::now();
+                write_manifest_behind();
               }
               if (progress)
                 progress(done, total_layers, static_cast<std::int64_t>(done) * grid.voxels_per_layer(),
@@ -408,6 +428,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
           }));
 
   const double pipeline_seconds = std::chrono::duration<double>(Clock::now() - pipeline_t0).count();
+  if (pending_manifest.valid()) pending_manifest.get();  // before the last manifest replaces it
   std::vector<std::int64_t> totals(static_cast<std::size_t>(nmat), 0);
   std::int64_t failures = 0;
   for (const auto& [k, l] : finished) {
