@@ -2,6 +2,10 @@
 
 #include "trivox/slice/trim.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -758,15 +762,9 @@ private:
       if (cur >= 0 && anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
         const Anchor& a = anchors_[static_cast<std::size_t>(cur)];
         const int iend = std::min(a.hi[ul], span_end);
-        // The run: certified and not taken (by an earlier cell), eight voxels at a time.
-        int j = i;
-        for (; j + 8 <= iend + 1; j += 8) {
-          int taken = 0;
-          for (int k = 0; k < 8; ++k) taken |= owner[j + k] >= 0;
-          if (taken) break;
-        }
-        while (j <= iend && owner[j] < 0) ++j;
-        fill(a, l, i, j, cell, owner, props, uvw);
+        // The run: certified and not taken (by an earlier cell), claimed as it is found.
+        const int j = claim_run(owner, i, iend, cell);
+        fill(a, l, i, j, props, uvw);
         out_->inverted[ul] += j - i;
         chain.n = 0;
         if (j > i) {
@@ -788,13 +786,31 @@ private:
     }
   }
 
-  /// Voxels i0 .. i1 - 1 of block row l from anchor a: cell index, uvw, and properties (Anchor's
-  /// comment): from the first-order model, or exact at the run's first and last voxels and every
-  /// a.step-th between and linear in between.
-  void fill(const Anchor& a, int l, int i0, int i1, int cell, std::int32_t* owner, float* props, double* uvw) {
+  /// Gives `cell` the voxels i, i + 1, ... up to iend that no earlier cell took (owner -1), and
+  /// returns the first one it did not give (a taken voxel, or iend + 1): eight at a time, as the
+  /// AND of their owners is negative exactly when all eight are -1.
+  static int claim_run(std::int32_t* owner, int i, int iend, int cell) {
+    int j = i;
+#if defined(__SSE2__)
+    const __m128i c = _mm_set1_epi32(cell);
+    for (; j + 8 <= iend + 1; j += 8) {
+      __m128i* o = reinterpret_cast<__m128i*>(owner + j);
+      const __m128i all = _mm_and_si128(_mm_loadu_si128(o), _mm_loadu_si128(o + 1));
+      if (_mm_movemask_ps(_mm_castsi128_ps(all)) != 0xF) break;
+      _mm_storeu_si128(o, c);
+      _mm_storeu_si128(o + 1, c);
+    }
+#endif
+    for (; j <= iend && owner[j] < 0; ++j) owner[j] = cell;
+    return j;
+  }
+
+  /// Voxels i0 .. i1 - 1 of block row l from anchor a (their owners set by claim_run): uvw and
+  /// properties (Anchor's comment): from the first-order model, or exact at the run's first and
+  /// last voxels and every a.step-th between and linear in between.
+  void fill(const Anchor& a, int l, int i0, int i1, float* props, double* uvw) {
     const int n = i1 - i0;
     if (n <= 0) return;
-    std::fill(owner + i0, owner + i1, cell);
     if (uvw)
       for (int j = i0; j < i1; ++j) {
         const Vec3 t = a.at(l, j);
@@ -816,11 +832,12 @@ private:
     vals_.resize(static_cast<std::size_t>(count) * um);
     for (int q = 0; q < count; ++q) pts_[static_cast<std::size_t>(q)] = a.at(l, i0 + std::min(q * step, n - 1));
     loc_.piece_properties(a.piece, pts_.data(), count, vals_.data());
+    const double inv_step = 1.0 / step;
     for (int q = 0; q + 1 < count; ++q) {
       const int ja = q * step, jb = std::min(ja + step, n - 1);
       const double* va = vals_.data() + static_cast<std::size_t>(q) * um;
       const double* vb = va + um;
-      const double inv = 1.0 / (jb - ja);
+      const double inv = jb - ja == step ? inv_step : 1.0 / (jb - ja);
       double slope[Expansion::max_props];
       for (std::size_t h = 0; h < um; ++h) slope[h] = (vb[h] - va[h]) * inv;
       write_(out + static_cast<std::size_t>(ja) * um, jb - ja, m_, va, slope);
