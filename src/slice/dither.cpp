@@ -725,17 +725,16 @@ struct GroupLoop {
     }
     __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
     mv = _mm256_max_ps(mv, masked[4]);
-    // The lowest material among equal maxima, in live lanes: eq_k and not any eq_j, j < k.
-    __m256 hit[K];
-    __m256 seen = _mm256_cmp_ps(masked[0], mv, _CMP_EQ_OQ);
-    hit[0] = _mm256_and_ps(seen, live);
-    for (int k = 1; k < K; ++k) {
-      const __m256 eq = _mm256_cmp_ps(masked[k], mv, _CMP_EQ_OQ);
-      hit[k] = _mm256_and_ps(_mm256_andnot_ps(seen, eq), live);
-      seen = _mm256_or_ps(seen, eq);
+    // The lowest material among equal maxima, in live lanes (void: 7): from the highest down,
+    // each equal one replaces the choice (one of them equals the maximum, so K - 1 stands when
+    // no lower one does); the hits are the lanes whose choice is k.
+    __m256i idx = _mm256_blendv_epi8(seven, _mm256_set1_epi32(K - 1), _mm256_castps_si256(live));
+    for (int k = K - 2; k >= 0; --k) {
+      const __m256 eq = _mm256_and_ps(_mm256_cmp_ps(masked[k], mv, _CMP_EQ_OQ), live);
+      idx = _mm256_blendv_epi8(idx, _mm256_set1_epi32(k), _mm256_castps_si256(eq));
     }
-    __m256i idx = _mm256_andnot_si256(_mm256_castps_si256(live), seven);  // void: 7
-    for (int k = 1; k < K; ++k) idx = _mm256_or_si256(idx, _mm256_and_si256(_mm256_castps_si256(hit[k]), _mm256_set1_epi32(k)));
+    __m256 hit[K];
+    for (int k = 0; k < K; ++k) hit[k] = _mm256_castsi256_ps(_mm256_cmpeq_epi32(idx, _mm256_set1_epi32(k)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_permutevar8x32_epi32(a.colours, idx));
     for (int k = 0; k < K; ++k) {
       const __m256 h = _mm256_and_ps(hit[k], one);
@@ -780,16 +779,12 @@ using GroupKernel = void (*)(const GroupRow&);
     }
     __m256 mv = _mm256_max_ps(_mm256_max_ps(masked[0], masked[1]), _mm256_max_ps(masked[2], masked[3]));
     mv = _mm256_max_ps(mv, masked[4]);
+    // As group_kernel: the lowest equal maximum from the highest down, the hits from the choice.
+    __m256i idx = _mm256_mask_mov_epi32(seven, live, _mm256_set1_epi32(K - 1));  // void: 7
+    for (int k = K - 2; k >= 0; --k)
+      idx = _mm256_mask_mov_epi32(idx, _mm256_mask_cmp_ps_mask(live, masked[k], mv, _CMP_EQ_OQ), _mm256_set1_epi32(k));
     __mmask8 hit[K];
-    __mmask8 seen = _mm256_cmp_ps_mask(masked[0], mv, _CMP_EQ_OQ);
-    hit[0] = seen & live;
-    for (int k = 1; k < K; ++k) {
-      const __mmask8 eq = _mm256_cmp_ps_mask(masked[k], mv, _CMP_EQ_OQ);
-      hit[k] = static_cast<__mmask8>(~seen & eq & live);
-      seen = static_cast<__mmask8>(seen | eq);
-    }
-    __m256i idx = _mm256_maskz_mov_epi32(static_cast<__mmask8>(~live), seven);  // void: 7
-    for (int k = 1; k < K; ++k) idx = _mm256_mask_mov_epi32(idx, hit[k], _mm256_set1_epi32(k));
+    for (int k = 0; k < K; ++k) hit[k] = _mm256_cmpeq_epi32_mask(idx, _mm256_set1_epi32(k));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_permutevar8x32_epi32(a.colours, idx));
     for (int k = 0; k < K; ++k) {
       g.cnt[k] = _mm256_mask_sub_epi32(g.cnt[k], hit[k], g.cnt[k], minus1);
