@@ -124,6 +124,16 @@ struct Anchor {
 /// Builds anchors from expansions: the certification of the struct comment above.
 class AnchorMaker {
 public:
+  /// A norm of the parameters for the certificate: s_j = scale_j t_j, with w and omega the
+  /// bounds of make() seen in it. norms_[0]: plain (scale 1); norms_[1]: D_j = |dX/dt_j| at the
+  /// anchor (invalid where a column of J0 vanishes).
+  struct Norm {
+    Vec3 scale{1.0, 1.0, 1.0};
+    std::array<Vec3, 3> w{};
+    double omega = 0.0;
+    bool valid = true;
+  };
+
   AnchorMaker(const Locator& loc, const VoxelGrid& grid, int m, int rows, double max_residual)
       : loc_(loc), m_(m), rows_(rows), px_(grid.pitch[0]), py_(grid.pitch[1]), max_residual_(max_residual),
         tol_(loc.options().tolerance), nx_(grid.count[0]) {}
@@ -148,18 +158,38 @@ public:
     // |J0^-1| taken entrywise, |J0^-1 v| <= | |J0^-1| b2v | for any v bounded entrywise by b2v,
     // so w[d][e] bounds |J0^-1 d^2X/dt_d dt_e| in the whole piece, whatever the cell's shape
     // (a layer-thin or sheared slab is as well conditioned as a cube).
-    std::array<Vec3, 3> ainv;
-    for (std::size_t r = 0; r < 3; ++r)
-      for (std::size_t k = 0; k < 3; ++k) ainv[r][k] = std::abs(inv[r][k]);
-    omega_ = 0.0;
+    // The norm is that of the scaled parameters s_j = D_j t_j, D_j = |dX/dt_j| at the anchor
+    // (lengths in mm): Newton-Kantorovich holds in any norm, and in the unscaled one a shell's
+    // thin direction (2 mm per unit of w) against its long one (125 mm per unit of u) made the
+    // curvature term J0^-1 d^2X/du^2 hundreds of units of w per unit of u, so that theta passed
+    // 1/2 within a few voxels although the linear model stayed exact to 1e-5 of the pitch.
+    // In s: G_s = D G, G_s' = D G' D^-1, so w[d][e] bounds |D J0^-1 d^2X/dt_d dt_e| / (D_d D_e).
+    // Both norms are kept (Norm): the scaled one certifies rectangles inside the part, the
+    // plain one is tried where that fails (an isotropic cell may do better unscaled) and alone
+    // certifies rectangles reaching out of the part (the layer-thin cells' faces).
+    Vec3 len{};
     for (std::size_t d = 0; d < 3; ++d) {
-      double row2 = 0.0;
-      for (std::size_t k = 0; k < 3; ++k) {
-        const Vec3 v = mul(ainv, b_->b2v[d][k]);
-        w_[d][k] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        row2 += w_[d][k] * w_[d][k];
+      const Vec3& c = e.jac[d];
+      len[d] = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    norms_[1].valid = len[0] > 0.0 && len[1] > 0.0 && len[2] > 0.0 && std::isfinite(len[0] + len[1] + len[2]);
+    norms_[0].scale = {1.0, 1.0, 1.0};
+    if (norms_[1].valid) norms_[1].scale = len;
+    for (Norm& nm : norms_) {
+      if (!nm.valid) continue;
+      std::array<Vec3, 3> ainv;
+      for (std::size_t r = 0; r < 3; ++r)
+        for (std::size_t k = 0; k < 3; ++k) ainv[r][k] = nm.scale[r] * std::abs(inv[r][k]);
+      nm.omega = 0.0;
+      for (std::size_t d = 0; d < 3; ++d) {
+        double row2 = 0.0;
+        for (std::size_t k = 0; k < 3; ++k) {
+          const Vec3 v = mul(ainv, b_->b2v[d][k]);
+          nm.w[d][k] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / (nm.scale[d] * nm.scale[k]);
+          row2 += nm.w[d][k] * nm.w[d][k];
+        }
+        nm.omega = std::max(nm.omega, std::sqrt(row2));  // |G_s'(x) - G_s'(y)|_F <= omega |x - y|_1 (in s)
       }
-      omega_ = std::max(omega_, std::sqrt(row2));  // |J0^-1 (J(x) - J(y))|_F <= omega |x - y|_1
     }
     gmax_ = {0.0, 0.0, 0.0};
     for (std::size_t h = 0; h < static_cast<std::size_t>(m_); ++h)
@@ -326,17 +356,23 @@ private:
     // Bounds hold in the piece's box; where the certificate reaches out of it (a voxel on or
     // next to a face) they are retried with every bound scaled by 1.01, valid as long as the
     // reach outside keeps the polynomial growth below that factor.
-    const int first = certified_with(kn, kp, ln, lp, 1.0);
-    return first > 0 || (first < 0 && certified_with(kn, kp, ln, lp, 1.01) > 0);
+    if (norms_[1].valid && certified_with(kn, kp, ln, lp, 1.0, norms_[1]) > 0) return true;
+    const int first = certified_with(kn, kp, ln, lp, 1.0, norms_[0]);
+    return first > 0 || (first < 0 && certified_with(kn, kp, ln, lp, 1.01, norms_[0]) > 0);
   }
 
   /// 1: certified; 0: not; -1: the certificate leaves the box (retry with a growth factor G).
-  int certified_with(int kn, int kp, int ln, int lp, double G) const {
+  int certified_with(int kn, int kp, int ln, int lp, double G, const Norm& nm) const {
+    const Vec3& scale_ = nm.scale;
+    const auto& w_ = nm.w;
+    const double omega_ = nm.omega;
+    const bool scaled = &nm != &norms_[0];
     const double K = std::max(kn, kp), L = std::max(ln, lp);
     const Vec3 a{std::abs(c0_[0]) + K * std::abs(dx_[0]) + L * std::abs(dy_[0]),
                  std::abs(c0_[1]) + K * std::abs(dx_[1]) + L * std::abs(dy_[1]),
                  std::abs(c0_[2]) + K * std::abs(dx_[2]) + L * std::abs(dy_[2])};
-    const double s1 = a[0] + a[1] + a[2];
+    const Vec3 as{scale_[0] * a[0], scale_[1] * a[1], scale_[2] * a[2]};  // in the scaled parameters
+    const double s1 = as[0] + as[1] + as[2];
     const double omega = G * omega_;
     const double theta = omega * s1;
     if (!(theta <= 0.5)) return 0;
@@ -344,14 +380,15 @@ private:
     const double e2 = G * (0.5 * (B[0][0] * a[0] * a[0] + B[1][1] * a[1] * a[1] + B[2][2] * a[2] * a[2]) +
                            B[0][1] * a[0] * a[1] + B[0][2] * a[0] * a[2] + B[1][2] * a[1] * a[2]);
     if (!(e2 <= max_residual_)) return 0;  // keeps the (u,v,w) reported meaningful
-    const double eta = G * (0.5 * (w_[0][0] * a[0] * a[0] + w_[1][1] * a[1] * a[1] + w_[2][2] * a[2] * a[2]) +
-                            w_[0][1] * a[0] * a[1] + w_[0][2] * a[0] * a[2] + w_[1][2] * a[1] * a[2]);
-    const double beta = 1.0 / (1.0 - theta);  // |G'(t)^-1| <= 1 / (1 - |G'(t) - I|)
+    const double eta = G * (0.5 * (w_[0][0] * as[0] * as[0] + w_[1][1] * as[1] * as[1] + w_[2][2] * as[2] * as[2]) +
+                            w_[0][1] * as[0] * as[1] + w_[0][2] * as[0] * as[2] + w_[1][2] * as[1] * as[2]);
+    const double beta = 1.0 / (1.0 - theta);  // |G_s'(t)^-1| <= 1 / (1 - |G_s'(t) - I|)
     const double h = beta * beta * sqrt3 * omega * eta;
     if (!(h <= 0.5)) return 0;
-    // Kantorovich: the root lies within (1 - sqrt(1 - 2h)) / (beta L) = 2 beta eta / (1 + sqrt(1 - 2h)).
+    // Kantorovich: the root lies within (1 - sqrt(1 - 2h)) / (beta L) = 2 beta eta / (1 + sqrt(1 - 2h))
+    // of t in the scaled parameters' 2-norm, so within R / D_j of t_j.
     const double R = 2.0 * beta * eta / (1.0 + std::sqrt(1.0 - 2.0 * h));
-    const Vec3 r{R, R, R};
+    const Vec3 r{R / scale_[0], R / scale_[1], R / scale_[2]};
     // How far the parameters and the ball around them leave the piece's box, per direction.
     // Leaving it by delta puts the root t* of the piece's polynomial up to delta outside, where
     // its point is still within slope * delta of the cell: allowed while that stays below the
@@ -370,6 +407,7 @@ private:
       off += b_->slope[j] * out[j];
     }
     if (off > 0.0) {
+      if (scaled) return 0;  // out of the part: the plain norm's proof alone
       // grow >= 1: too far out whatever the growth factor (and a larger G only reaches farther).
       if (!(off <= tol_)) return 0;
       double grow = 1.0;
@@ -404,8 +442,7 @@ private:
   const Expansion* e_ = nullptr;
   Vec3 c0_{}, dx_{}, dy_{};
   Vec3 gmax_{};                 ///< largest |dP_h/dt_d| at the anchor
-  std::array<Vec3, 3> w_{};     ///< bounds on |J0^-1 d^2X/dt_d dt_e|
-  double omega_ = 0.0;
+  std::array<Norm, 2> norms_{};
   Vec3 room_lo_{}, room_hi_{}, inv_dx_{};  ///< box_cap's terms (0 in inv_dx_: unbounded)
   mutable Errors err_;          ///< the property errors of the last rectangle certified
   std::array<int, 3> guess_{-1, -1, -1};

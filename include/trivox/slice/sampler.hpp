@@ -16,7 +16,10 @@
 ///   t = t0 + J0^-1 (p - X0). The piece's bounds on second partials (StepBounds) turn that into
 ///   a certificate: a Taylor bound on |J0^-1 (X(t) - p)|, the Newton-Kantorovich theorem in its
 ///   affine-covariant form (Deuflhard; so thin, sheared or layer-thin cells are as well served as
-///   cubes) for an exact preimage t* within a radius r of t inside the piece (so p is inside the
+///   cubes in the image space; in the parameter space the norm is also taken with each t_j
+///   scaled by |dX/dt_j| at the anchor, so that a shell 2 mm thick and 125 mm around is not
+///   refused after a few voxels, the plain norm tried where that fails and alone used where a
+///   rectangle reaches out of the piece) for an exact preimage t* within a radius r of t inside the piece (so p is inside the
 ///   cell; or outside the piece by less than the tolerance, where the contract allows either
 ///   answer: a layer through a face between cells is certified too), and a bound on the
 ///   properties' error below 0.95/512. The properties come from the first-order model
