@@ -240,12 +240,18 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const int total_layers = manifest.layer_range[1] - manifest.layer_range[0];
 
   // The manifest lists only layers already on disk: sync first.
+  auto list_finished = [&](Manifest& m, bool complete) {
+    m.layers.clear();
+    for (const auto& [k, l] : finished) m.layers.push_back(l);
+    m.complete = complete;
+  };
+  auto sync_and_write = [](const fs::path& dir, const Manifest& m) {
+    sync_folder_contents(dir);
+    write_file_atomically(dir / m.shard.manifest_name(), manifest_json(m));
+  };
   auto write_manifest = [&](bool complete) {
-    sync_folder_contents(opt.out_dir);
-    manifest.layers.clear();
-    for (const auto& [k, l] : finished) manifest.layers.push_back(l);
-    manifest.complete = complete;
-    write_file_atomically(opt.out_dir / manifest.shard.manifest_name(), manifest_json(manifest));
+    list_finished(manifest, complete);
+    sync_and_write(opt.out_dir, manifest);
   };
   write_manifest(false);
   auto last_manifest = Clock::now();
@@ -260,12 +266,9 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       pending_manifest.get();  // rethrows its error
     }
     Manifest snapshot = manifest;
-    snapshot.layers.clear();
-    for (const auto& [k, l] : finished) snapshot.layers.push_back(l);
-    snapshot.complete = false;
-    pending_manifest = std::async(std::launch::async, [snapshot = std::move(snapshot), dir = opt.out_dir] {
-      sync_folder_contents(dir);
-      write_file_atomically(dir / snapshot.shard.manifest_name(), manifest_json(snapshot));
+    list_finished(snapshot, false);
+    pending_manifest = std::async(std::launch::async, [snapshot = std::move(snapshot), dir = opt.out_dir, sync_and_write] {
+      sync_and_write(dir, snapshot);
     });
     last_manifest = Clock::now();
   };

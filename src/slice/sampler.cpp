@@ -173,8 +173,7 @@ public:
       len[d] = std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     }
     norms_[1].valid = len[0] > 0.0 && len[1] > 0.0 && len[2] > 0.0 && std::isfinite(len[0] + len[1] + len[2]);
-    norms_[0].scale = {1.0, 1.0, 1.0};
-    if (norms_[1].valid) norms_[1].scale = len;
+    if (norms_[1].valid) norms_[1].scale = len;  // norms_[0] keeps scale 1
     for (Norm& nm : norms_) {
       if (!nm.valid) continue;
       std::array<Vec3, 3> ainv;
@@ -363,32 +362,31 @@ private:
 
   /// 1: certified; 0: not; -1: the certificate leaves the box (retry with a growth factor G).
   int certified_with(int kn, int kp, int ln, int lp, double G, const Norm& nm) const {
-    const Vec3& scale_ = nm.scale;
-    const auto& w_ = nm.w;
-    const double omega_ = nm.omega;
+    const Vec3& D = nm.scale;
+    const auto& w = nm.w;
     const bool scaled = &nm != &norms_[0];
     const double K = std::max(kn, kp), L = std::max(ln, lp);
     const Vec3 a{std::abs(c0_[0]) + K * std::abs(dx_[0]) + L * std::abs(dy_[0]),
                  std::abs(c0_[1]) + K * std::abs(dx_[1]) + L * std::abs(dy_[1]),
                  std::abs(c0_[2]) + K * std::abs(dx_[2]) + L * std::abs(dy_[2])};
-    const Vec3 as{scale_[0] * a[0], scale_[1] * a[1], scale_[2] * a[2]};  // in the scaled parameters
+    const Vec3 as{D[0] * a[0], D[1] * a[1], D[2] * a[2]};  // in the scaled parameters
     const double s1 = as[0] + as[1] + as[2];
-    const double omega = G * omega_;
+    const double omega = G * nm.omega;
     const double theta = omega * s1;
     if (!(theta <= 0.5)) return 0;
     const auto& B = b_->b2;
     const double e2 = G * (0.5 * (B[0][0] * a[0] * a[0] + B[1][1] * a[1] * a[1] + B[2][2] * a[2] * a[2]) +
                            B[0][1] * a[0] * a[1] + B[0][2] * a[0] * a[2] + B[1][2] * a[1] * a[2]);
     if (!(e2 <= max_residual_)) return 0;  // keeps the (u,v,w) reported meaningful
-    const double eta = G * (0.5 * (w_[0][0] * as[0] * as[0] + w_[1][1] * as[1] * as[1] + w_[2][2] * as[2] * as[2]) +
-                            w_[0][1] * as[0] * as[1] + w_[0][2] * as[0] * as[2] + w_[1][2] * as[1] * as[2]);
+    const double eta = G * (0.5 * (w[0][0] * as[0] * as[0] + w[1][1] * as[1] * as[1] + w[2][2] * as[2] * as[2]) +
+                            w[0][1] * as[0] * as[1] + w[0][2] * as[0] * as[2] + w[1][2] * as[1] * as[2]);
     const double beta = 1.0 / (1.0 - theta);  // |G_s'(t)^-1| <= 1 / (1 - |G_s'(t) - I|)
     const double h = beta * beta * sqrt3 * omega * eta;
     if (!(h <= 0.5)) return 0;
     // Kantorovich: the root lies within (1 - sqrt(1 - 2h)) / (beta L) = 2 beta eta / (1 + sqrt(1 - 2h))
     // of t in the scaled parameters' 2-norm, so within R / D_j of t_j.
     const double R = 2.0 * beta * eta / (1.0 + std::sqrt(1.0 - 2.0 * h));
-    const Vec3 r{R / scale_[0], R / scale_[1], R / scale_[2]};
+    const Vec3 r{R / D[0], R / D[1], R / D[2]};
     // How far the parameters and the ball around them leave the piece's box, per direction.
     // Leaving it by delta puts the root t* of the piece's polynomial up to delta outside, where
     // its point is still within slope * delta of the cell: allowed while that stays below the

@@ -435,6 +435,37 @@ TEST_CASE("sampler: a wedge, one face collapsed onto an edge (zero Jacobian ther
   CHECK(failures == 0);
 }
 
+TEST_CASE("sampler: the contract holds on a thin curved shell at printer pitch (the scaled certificate)") {
+  // A quarter of a cylindrical wall 2 mm thick at radius 20 mm (u: a cubic Bezier arc, v:
+  // radial, w: along z), like the teapot's body: in the plain parameter norm its curvature term
+  // refuses anchors after a few voxels, in the norm scaled by |dX/dt_j| they span the wall.
+  // The scaled proof must keep the contract: occupancy, properties within 1/512, volume.
+  const double r1 = 18, r2 = 20, h = 1, k = 4.0 / 3.0 * (std::sqrt(2.0) - 1.0);
+  std::vector<double> pts;
+  for (int c = 0; c < 2; ++c)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 4; ++i) {
+        const double r = j ? r2 : r1;
+        const double xy[4][2] = {{r, 0}, {r, k * r}, {k * r, r}, {0, r}};
+        pts.insert(pts.end(), {xy[i][0], xy[i][1], c * h, 0.2 + 0.2 * i, 0.3 + 0.4 * j, 0.5 + 0.3 * c * (i % 2)});
+      }
+  const auto cub = spline::KnotVector::bezier(4), lin = spline::KnotVector::bezier(2);
+  const auto m = model_of({Trivariate({cub, lin, lin}, 6, pts)}, {"r", "g", "b"});
+  slice::SamplerOptions so;
+  so.keep_uvw = true;
+  const auto j750 = slice::printer_preset("j750");
+  const auto b = slice::model_bounds(m);
+  auto grid = VoxelGrid::covering(b[0], b[1], {j750.pitch_x(), j750.pitch_y(), j750.pitch_z()});
+  grid.origin[2] += 15 * grid.pitch[2];
+  grid.count[2] = 4;
+  const LayerSampler s(m, grid, so);
+  const auto c = check_contract(m, s, 2);
+  const double vol = static_cast<double>(c.inside) * grid.pitch[0] * grid.pitch[1] * grid.pitch[2];
+  const double exact = geom::volume(m.cells[0].volume) * 4 * grid.pitch[2] / h;
+  INFO("voxel volume " << vol << ", quadrature volume of the slab " << exact);
+  CHECK(std::abs(vol - exact) < 0.01 * exact);
+}
+
 TEST_CASE("sampler: a layer through the faces between stacked cells, and layer-thin cells") {
   // The demo column (four cells stacked along z) squashed to one J750 layer: each cell is
   // 6.75 um thick and layer 0's centre lies exactly on the face between the second and third

@@ -67,6 +67,13 @@ io::SliceJobSummary run(const vmodel::VModel& m, const fs::path& dir, int thread
   return io::run_slice_job(m, opt);
 }
 
+/// A job's pipeline thread-seconds outside its stages (writing and idle).
+double outside_stages(const io::SliceJobSummary& job, int threads) {
+  double staged = 0.0;
+  for (double x : job.stage_seconds) staged += x;
+  return threads * job.pipeline_seconds - staged;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -100,9 +107,7 @@ int main(int argc, char** argv) {
                 job.grid.count[2], job.seconds, job.pipeline_seconds);
     for (std::size_t i = 0; i < job.stage_seconds.size(); ++i)
       std::printf(" %s %.1f", io::slice_stage_names[i], 1e9 * job.stage_seconds[i] / static_cast<double>(job.voxels));
-    double staged = 0.0;
-    for (double x : job.stage_seconds) staged += x;
-    std::printf(", outside the stages %.3f thread-s\n", threads * job.pipeline_seconds - staged);
+    std::printf(", outside the stages %.3f thread-s\n", outside_stages(job, threads));
     fs::remove_all(tmp);
     return 0;
   }
@@ -143,11 +148,9 @@ int main(int argc, char** argv) {
     std::printf(" %s %.3f (%.1f)", io::slice_stage_names[i], job.stage_seconds[i],
                 1e9 * job.stage_seconds[i] / static_cast<double>(job.voxels));
   std::printf("\n");
-  double staged = 0.0;
-  for (double x : job.stage_seconds) staged += x;
   std::printf("job pipeline (layers sampled to files written): %.3f s wall; thread-seconds outside the stages (writing "
               "and idle): %.3f\n",
-              job.pipeline_seconds, threads * job.pipeline_seconds - staged);
+              job.pipeline_seconds, outside_stages(job, threads));
 
   // 2. One 1516 x 2524 slice on one thread.
   {
