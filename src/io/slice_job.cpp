@@ -60,10 +60,11 @@ struct Scratch {
   slice::RowBand band;
   std::optional<slice::LayerDitherer> dither;  ///< its error rows, allocated once per thread
   std::vector<std::uint8_t> rgba;
-  // Grouped layers (slice::LayerGroupDitherer): a band and the pixels of each layer of a group.
+  // Grouped layers (slice::LayerGroupDitherer): a band and the material indices of each layer
+  // of a group (a byte per pixel, painted while they are encoded).
   std::optional<slice::LayerGroupDitherer> group;
   std::vector<slice::RowBand> bands;
-  std::vector<std::vector<std::uint8_t>> rgbas;
+  std::vector<std::vector<std::uint8_t>> indices;
   std::array<double, 5> seconds{};  ///< per stage, see SliceJobSummary::stage_seconds
 };
 
@@ -280,12 +281,12 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
 
   // Work items are groups of layers. On the colour path with fs, a group of up to 8 layers is
   // dithered together, one layer per vector lane (slice::LayerGroupDitherer: the same pixels as
-  // one layer at a time, at a fraction of the cost), when each thread's group of pixel buffers
-  // fits in group_budget / threads; otherwise every group is one layer. The groups split the
+  // one layer at a time, at a fraction of the cost), when each thread's group of index buffers
+  // (a byte per pixel) fits in group_budget / threads; otherwise every group is one layer. The groups split the
   // layers to do into a multiple of the thread count of nearly equal sizes, so that no thread
   // is left with a last group alone.
-  constexpr double group_budget = 1024.0 * 1024.0 * 1024.0;  // bytes of RGBA layers in all groups
-  const double layer_bytes = static_cast<double>(nx) * static_cast<double>(ny) * 4.0;
+  constexpr double group_budget = 1024.0 * 1024.0 * 1024.0;  // bytes of index layers in all groups
+  const double layer_bytes = static_cast<double>(nx) * static_cast<double>(ny);
   // TRIVOX_LAYER_GROUP=N caps the group size (diagnostics and tests: the output is the same).
   int group_cap = slice::LayerGroupDitherer::max_layers;
   if (const char* env = std::getenv("TRIVOX_LAYER_GROUP"))
@@ -305,9 +306,10 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
   std::size_t next = 0;
 
-  // A layer's pixels into its PNG and the PNG's digest.
-  auto encode = [&](LayerOut& out, const std::uint8_t* pixels) {
-    out.png = encode_png_rgba(pixels, nx, ny, cfg.dpi_x, cfg.dpi_y);
+  // A layer's PNG, from its pixels (RGBA) or its material indices, and the PNG's digest.
+  auto encode = [&](LayerOut& out, const std::uint8_t* pixels, bool indexed) {
+    out.png = indexed ? encode_png_indexed(pixels, nx, ny, colour, cfg.dpi_x, cfg.dpi_y)
+                      : encode_png_rgba(pixels, nx, ny, cfg.dpi_x, cfg.dpi_y);
     out.sha256 = sha256_hex(out.png);
   };
 
@@ -337,7 +339,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       lap(t, s.seconds[2]);
     }
     out.counts = std::move(counts);
-    encode(out, s.rgba.data());
+    encode(out, s.rgba.data(), false);
     lap(t, s.seconds[4]);
     return out;
   };
@@ -355,15 +357,15 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     const auto un = static_cast<std::size_t>(n), unx = static_cast<std::size_t>(nx);
     if (!s.group) s.group.emplace(nx, mapper, grid.pitch[0], grid.pitch[1]);
     s.bands.resize(un);
-    s.rgbas.resize(un);
+    s.indices.resize(un);
     outs.resize(un);
     std::vector<std::vector<std::int64_t>> counts(un, std::vector<std::int64_t>(static_cast<std::size_t>(nmat), 0));
     const std::int32_t* cell[slice::LayerGroupDitherer::max_layers];
     const float* props[slice::LayerGroupDitherer::max_layers];
-    std::uint8_t* rgba[slice::LayerGroupDitherer::max_layers];
+    std::uint8_t* index[slice::LayerGroupDitherer::max_layers];
     std::int64_t* count[slice::LayerGroupDitherer::max_layers];
     for (std::size_t i = 0; i < un; ++i) {
-      s.rgbas[i].resize(unx * static_cast<std::size_t>(ny) * 4);
+      s.indices[i].resize(unx * static_cast<std::size_t>(ny));
       outs[i].layer = layers[i];
       count[i] = counts[i].data();
     }
@@ -384,9 +386,9 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
         for (std::size_t i = 0; i < un; ++i) {
           cell[i] = s.bands[i].cell.data() + ur * unx;
           props[i] = s.bands[i].props.data() + ur * unx * static_cast<std::size_t>(nprops);
-          rgba[i] = s.rgbas[i].data() + (static_cast<std::size_t>(r0) + ur) * unx * 4;
+          index[i] = s.indices[i].data() + (static_cast<std::size_t>(r0) + ur) * unx;
         }
-        s.group->dither_paint(r0 + r, cell, props, colour, rgba, count);
+        s.group->dither(r0 + r, cell, props, index, count);
       }
       lap(t, s.seconds[2]);
     }
@@ -398,7 +400,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       tbb::parallel_for(std::size_t{0}, un, [&](std::size_t i) {
         double te = thread_cpu_seconds();
         outs[i].counts = std::move(counts[i]);
-        encode(outs[i], s.rgbas[i].data());
+        encode(outs[i], s.indices[i].data(), true);
         lap(te, scratch.local().seconds[4]);
       });
     });

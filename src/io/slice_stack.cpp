@@ -7,6 +7,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 #include <zip.h>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <cerrno>
@@ -18,6 +21,7 @@
 #include <ctime>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <pugixml.hpp>
 #include <set>
 #include <sstream>
@@ -218,34 +222,115 @@ const std::uint8_t* PngRowReader::row(int y) {
 // ------------------------------------------------------------------------------------------------
 // PNG
 
-std::string encode_png_rgba(const std::uint8_t* rgba, int width, int height, double dpi_x, double dpi_y, int level) {
-  if (width <= 0 || height <= 0)
-    throw Error("PNG of " + std::to_string(width) + " x " + std::to_string(height) +
-                " pixels; expected a positive width and height");
-  if (level < 0 || level > 9)
-    throw Error("PNG zlib level " + std::to_string(level) + "; expected 0..9");
-  OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:UnassociatedAlpha", 1);  // the pixels are final colours: store them as given
-  spec.attribute("png:compressionLevel", level);
-  spec.attribute("png:filter", 0x08);  // PNG_FILTER_NONE (png.h): no per-row filter trials
-  if (dpi_x > 0 && dpi_y > 0) {
-    // pHYs holds whole pixels per metre and OpenImageIO truncates: hand it the rounded value
-    // (exact in a float below 2^24, i.e. any dpi up to 400000).
-    spec.attribute("ResolutionUnit", "m");
-    spec.attribute("XResolution", static_cast<float>(std::round(dpi_x / 0.0254)));
-    spec.attribute("YResolution", static_cast<float>(std::round(dpi_y / 0.0254)));
+namespace {
+
+/// An OpenImageIO PNG encoder into memory with the slices' settings (encode_png_rgba's comment).
+class PngEncoder {
+public:
+  PngEncoder(int width, int height, double dpi_x, double dpi_y, int level) : proxy_(buffer_) {
+    if (width <= 0 || height <= 0)
+      throw Error("PNG of " + std::to_string(width) + " x " + std::to_string(height) +
+                  " pixels; expected a positive width and height");
+    if (level < 0 || level > 9) throw Error("PNG zlib level " + std::to_string(level) + "; expected 0..9");
+    OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:UnassociatedAlpha", 1);  // the pixels are final colours: store them as given
+    spec.attribute("png:compressionLevel", level);
+    spec.attribute("png:filter", 0x08);  // PNG_FILTER_NONE (png.h): no per-row filter trials
+    if (dpi_x > 0 && dpi_y > 0) {
+      // pHYs holds whole pixels per metre and OpenImageIO truncates: hand it the rounded value
+      // (exact in a float below 2^24, i.e. any dpi up to 400000).
+      spec.attribute("ResolutionUnit", "m");
+      spec.attribute("XResolution", static_cast<float>(std::round(dpi_x / 0.0254)));
+      spec.attribute("YResolution", static_cast<float>(std::round(dpi_y / 0.0254)));
+    }
+    buffer_.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) / 16 + 4096);
+    out_ = OIIO::ImageOutput::create("png", &proxy_);
+    if (!out_) throw Error("PNG encoder unavailable: " + OIIO::geterror(), ErrorKind::failed);
+    if (!out_->open("slice.png", spec)) fail();
   }
-  std::vector<unsigned char> buffer;
-  buffer.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) / 16 + 4096);
-  OIIO::Filesystem::IOVecOutput proxy(buffer);
-  auto out = OIIO::ImageOutput::create("png", &proxy);
-  if (!out) throw Error("PNG encoder unavailable: " + OIIO::geterror(), ErrorKind::failed);
-  const bool ok = out->open("slice.png", spec) && out->write_image(OIIO::TypeDesc::UINT8, rgba) && out->close();
-  if (!ok) {
-    std::string why = out->geterror();
+  /// The whole image, rows top to bottom.
+  void image(const std::uint8_t* rgba) {
+    if (!out_->write_image(OIIO::TypeDesc::UINT8, rgba)) fail();
+  }
+  /// Rows [y0, y1), in order.
+  void rows(int y0, int y1, const std::uint8_t* rgba) {
+    if (!out_->write_scanlines(y0, y1, 0, OIIO::TypeDesc::UINT8, rgba)) fail();
+  }
+  std::string finish() {
+    if (!out_->close()) fail();
+    return std::string(buffer_.begin(), buffer_.end());
+  }
+
+private:
+  [[noreturn]] void fail() {
+    std::string why = out_->geterror();
     throw Error("PNG encoding failed: " + (why.empty() ? std::string("unknown error") : why), ErrorKind::failed);
   }
-  return std::string(buffer.begin(), buffer.end());
+  std::vector<unsigned char> buffer_;
+  OIIO::Filesystem::IOVecOutput proxy_;
+  std::unique_ptr<OIIO::ImageOutput> out_;
+};
+
+/// rgba[4 j ..] = colours[index[j]] for j < n.
+void paint_scalar(const std::uint8_t* index, std::size_t n, const std::array<std::uint32_t, 256>& colours, std::uint8_t* rgba) {
+  for (std::size_t j = 0; j < n; ++j) std::memcpy(rgba + 4 * j, &colours[index[j]], 4);
+}
+
+#if defined(__x86_64__)
+/// paint_scalar eight pixels at a time where their indices are 0..6 or 255 (a palette of up to
+/// seven materials, and void): one permute from a table of those eight colours.
+[[gnu::target("avx2")]] void paint_avx2(const std::uint8_t* index, std::size_t n, const std::array<std::uint32_t, 256>& colours,
+                                        std::uint8_t* rgba) {
+  std::int32_t t[8];
+  for (int k = 0; k < 7; ++k) t[k] = static_cast<std::int32_t>(colours[static_cast<std::size_t>(k)]);
+  t[7] = static_cast<std::int32_t>(colours[255]);
+  const __m256i table = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(t));
+  const __m256i seven = _mm256_set1_epi32(7), ff = _mm256_set1_epi32(255);
+  std::size_t j = 0;
+  for (; j + 8 <= n; j += 8) {
+    const __m256i b = _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(index + j)));
+    const __m256i lane = _mm256_min_epu32(b, seven);
+    // An index 7..254 (lane 7 but not void) takes the table of all 256.
+    const __m256i other = _mm256_andnot_si256(_mm256_cmpeq_epi32(b, ff), _mm256_cmpeq_epi32(lane, seven));
+    if (!_mm256_testz_si256(other, other)) {
+      paint_scalar(index + j, 8, colours, rgba + 4 * j);
+      continue;
+    }
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgba + 4 * j), _mm256_permutevar8x32_epi32(table, lane));
+  }
+  paint_scalar(index + j, n - j, colours, rgba + 4 * j);
+}
+#endif
+
+void paint(const std::uint8_t* index, std::size_t n, const std::array<std::uint32_t, 256>& colours, std::uint8_t* rgba) {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return paint_avx2(index, n, colours, rgba);
+#endif
+  paint_scalar(index, n, colours, rgba);
+}
+
+}  // namespace
+
+std::string encode_png_rgba(const std::uint8_t* rgba, int width, int height, double dpi_x, double dpi_y, int level) {
+  PngEncoder enc(width, height, dpi_x, dpi_y, level);
+  enc.image(rgba);
+  return enc.finish();
+}
+
+std::string encode_png_indexed(const std::uint8_t* index, int width, int height, const std::array<std::uint32_t, 256>& colours,
+                               double dpi_x, double dpi_y, int level) {
+  PngEncoder enc(width, height, dpi_x, dpi_y, level);
+  // Strips of rows painted into a buffer that stays in the L1/L2 cache while libpng reads it.
+  const auto w = static_cast<std::size_t>(width);
+  const int strip = std::max(1, static_cast<int>(32768 / w));
+  std::vector<std::uint8_t> rgba(static_cast<std::size_t>(std::min(strip, height)) * w * 4);
+  for (int y0 = 0; y0 < height; y0 += strip) {
+    const int y1 = std::min(height, y0 + strip);
+    paint(index + static_cast<std::size_t>(y0) * w, static_cast<std::size_t>(y1 - y0) * w, colours, rgba.data());
+    enc.rows(y0, y1, rgba.data());
+  }
+  return enc.finish();
 }
 
 RgbaImage decode_png_rgba(std::string_view bytes, const std::string& source) {

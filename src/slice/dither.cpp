@@ -531,7 +531,7 @@ struct GroupRow {
   int np, ir, ig, ib;
   const float* in;             // (nx + 2) * group_stride: incoming error, one pad column each side
   float* down;                 // the same for the next row (every column and both pads stored)
-  __m256i colours;             // RGBA of materials 0..4 in lanes 0..4, lane 7 void (0 0 0 0)
+  __m256i colours;             // per choice the value written (lanes 0..4; lane 7 void): RGBA, or the index
   std::int32_t* rgba;          // nx * 8: the chosen colour of column c at c * 8
   __m256* counts;              // group_k vectors: per material, per lane, added to
 };
@@ -589,6 +589,31 @@ struct GroupRow {
     for (int l = 0; l < lanes; ++l) std::memcpy(d[l] + j, s + j * 8 + static_cast<std::size_t>(l), 4);
 }
 
+/// dst[l][j] = the low byte of src[j * 8 + l] (int32) for j < n and l < lanes: from_lanes into
+/// bytes (material indices), each layer's eight columns packed by one byte shuffle.
+[[gnu::target("avx2")]] void from_lanes_bytes(const void* src, std::size_t n, int lanes, std::uint8_t* const* dst) noexcept {
+  const float* s = static_cast<const float*>(src);
+  // Byte 0 of each 32-bit element into bytes 0..3 of its 128-bit half, then both halves' four
+  // into the low eight bytes.
+  const __m256i pick = _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12, -1, -1, -1,
+                                        -1, -1, -1, -1, -1, -1, -1, -1, -1);
+  const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
+  std::size_t j = 0;
+  for (; j + 8 <= n; j += 8) {
+    const float* q = s + j * 8;
+    __m256 r[8];
+    for (int l = 0; l < 8; ++l) r[l] = _mm256_loadu_ps(q + 8 * l);
+    transpose8(r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]);
+    for (int l = 0; l < lanes; ++l) {
+      const __m256i b = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(_mm256_castps_si256(r[l]), pick), join);
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(dst[l] + j), _mm256_castsi256_si128(b));
+    }
+  }
+  const auto* si = static_cast<const std::int32_t*>(src);
+  for (; j < n; ++j)
+    for (int l = 0; l < lanes; ++l) dst[l][j] = static_cast<std::uint8_t>(si[j * 8 + static_cast<std::size_t>(l)]);
+}
+
 /// What the two group kernels share: the row's pointers and weights, the state carried along the
 /// row (per material the error for the next voxel and the two accumulating in the next row), and
 /// the steps that do not depend on how the lanes' masks are held.
@@ -608,6 +633,7 @@ struct GroupLoop {
   __m256i cnt[K];
   const __m256 none = _mm256_set1_ps(-3.0e38f), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
   const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
+  const __m256i void_px = _mm256_permutevar8x32_epi32(a.colours, seven);  // the table's void entry in every lane
 
   [[gnu::target("avx2"), gnu::always_inline]] explicit GroupLoop(const GroupRow& row)
       : a(row), nx(row.nx), dir(row.left_to_right ? 1 : -1), x(row.left_to_right ? 0 : row.nx - 1), in(row.in + S),
@@ -639,7 +665,7 @@ struct GroupLoop {
   }
   /// Every layer void at column xs: the error aimed here is dropped, none leaves.
   [[gnu::target("avx2"), gnu::always_inline]] void void_column(std::ptrdiff_t xs, float* d_back) {
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_setzero_si256());
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), void_px);
     for (int k = 0; k < K; ++k) {
       _mm256_storeu_ps(d_back + 8 * k, acc_here[k]);
       acc_here[k] = acc_fwd[k];
@@ -822,6 +848,7 @@ bool group_kernel_available() noexcept {
 bool group_kernel_available() noexcept { return false; }
 void to_lanes(const void* const*, std::size_t, void*) noexcept {}
 void from_lanes(const void*, std::size_t, int, void* const*) noexcept {}
+void from_lanes_bytes(const void*, std::size_t, int, std::uint8_t* const*) noexcept {}
 void group_row(int, bool, const float (*)[4][8], const std::int32_t*, const float*, int, int, int, int, const float*, float*,
                const std::int32_t*, std::int32_t*, float (*)[8]) {}
 #endif  // TRIVOX_DITHER_AVX2
@@ -1031,7 +1058,6 @@ LayerGroupDitherer::LayerGroupDitherer(int nx, const MaterialMapper& mapper, dou
   chosen_.assign(n * 8, 0);
   no_props_.assign(n * np, 0.0f);
   no_cells_.assign(n, -1);
-  scratch_.assign(n * 4, 0);
 }
 
 void LayerGroupDitherer::begin(int layers) {
@@ -1043,11 +1069,9 @@ void LayerGroupDitherer::begin(int layers) {
   std::fill(error_.begin(), error_.end(), 0.0f);
 }
 
-void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
-                                      const std::array<std::uint32_t, 256>& colours, std::uint8_t* const* rgba,
-                                      std::int64_t* const* counts) {
-  const FlushDenormals flush;
-  if (layers_ < 1) throw Error("dithering: dither_paint before begin()", ErrorKind::failed);
+void LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
+                              std::int64_t* const* counts) {
+  if (layers_ < 1) throw Error("dithering: a row before begin()", ErrorKind::failed);
   if (row < 0 || row < next_row_)
     throw Error("dithering: row " + std::to_string(row) + " after rows up to " + std::to_string(next_row_ - 1) +
                     "; expected increasing rows (error diffusion runs downwards)",
@@ -1058,29 +1082,45 @@ void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, 
   const auto nx = static_cast<std::size_t>(nx_), np = static_cast<std::size_t>(np_);
   const void* cs[8];
   const void* ps[8];
-  void* outs[8];
   for (int l = 0; l < 8; ++l) {
     const bool used = l < layers_;
     cs[l] = used ? static_cast<const void*>(cell[l]) : no_cells_.data();
     ps[l] = used ? static_cast<const void*>(props[l]) : no_props_.data();
-    outs[l] = used ? static_cast<void*>(rgba[l]) : scratch_.data();
   }
   to_lanes(cs, nx, cell_.data() + 8);
   to_lanes(ps, nx * np, props_.data());
   const std::size_t half = error_.size() / 2;
   float* in = error_.data() + (row % 2 == 0 ? 0 : half);
   float* down = error_.data() + (row % 2 == 0 ? half : 0);
-  std::int32_t table[8] = {};
-  for (int k = 0; k < group_k; ++k) table[k] = static_cast<std::int32_t>(colours[static_cast<std::size_t>(k)]);
-  table[7] = static_cast<std::int32_t>(colours[void_material]);
   float lane_counts[group_k][8] = {};
-  group_row(nx_, row % 2 == 0, weights_, cell_.data(), props_.data(), np_, ir_, ig_, ib_, in, down, table,
-            chosen_.data(), lane_counts);
-  from_lanes(chosen_.data(), nx, layers_, outs);
+  group_row(nx_, row % 2 == 0, weights_, cell_.data(), props_.data(), np_, ir_, ig_, ib_, in, down, table, chosen_.data(),
+            lane_counts);
   std::fill(in, in + group_stride, 0.0f);  // as fs_row
   std::fill(in + half - group_stride, in + half, 0.0f);
   for (int l = 0; l < layers_; ++l)
     for (int k = 0; k < group_k; ++k) counts[l][k] += static_cast<std::int64_t>(lane_counts[k][l]);
+}
+
+void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
+                                      const std::array<std::uint32_t, 256>& colours, std::uint8_t* const* rgba,
+                                      std::int64_t* const* counts) {
+  const FlushDenormals flush;
+  // The kernel writes table[choice] per lane (choice 7: void).
+  std::int32_t table[8] = {};
+  for (int k = 0; k < group_k; ++k) table[k] = static_cast<std::int32_t>(colours[static_cast<std::size_t>(k)]);
+  table[7] = static_cast<std::int32_t>(colours[void_material]);
+  row_(row, cell, props, table, counts);
+  void* outs[8];
+  for (int l = 0; l < layers_; ++l) outs[l] = rgba[l];
+  from_lanes(chosen_.data(), static_cast<std::size_t>(nx_), layers_, outs);
+}
+
+void LayerGroupDitherer::dither(int row, const std::int32_t* const* cell, const float* const* props, std::uint8_t* const* index,
+                                std::int64_t* const* counts) {
+  const FlushDenormals flush;
+  const std::int32_t table[8] = {0, 1, 2, 3, 4, 0, 0, void_material};
+  row_(row, cell, props, table, counts);
+  from_lanes_bytes(chosen_.data(), static_cast<std::size_t>(nx_), layers_, index);
 }
 
 }  // namespace trivox::slice

@@ -9,6 +9,7 @@
 #include <map>
 #include <pugixml.hpp>
 #include <random>
+#include <tuple>
 
 #include "io_test_util.hpp"
 #include "trivox/io/model_file.hpp"
@@ -180,6 +181,34 @@ TEST_CASE("encode_png_rgba: OpenImageIO reads back the same pixels and pHYs", "[
   check_message(error_of([&] { encode_png_rgba(px.data(), 0, h, 600, 300); }), {"0 x 23", "expected a positive"});
   check_message(error_of([&] { decode_png_rgba(png.substr(0, png.size() / 2), "half.png"); }), {"half.png", "expected a complete PNG"});
   check_message(error_of([&] { decode_png_rgba("not a png", "text.png"); }), {"text.png: not a PNG", "expected a PNG file"});
+}
+
+TEST_CASE("encode_png_indexed: the bytes of encode_png_rgba of the painted image", "[io][stack][png]") {
+  // Widths around the eight-pixel vectors and the painting strips (32768 / width rows each),
+  // heights of several strips; indices of a small palette with void (the vector path), and
+  // every other byte value (the table of 256) scattered among them.
+  std::array<std::uint32_t, 256> colours{};
+  std::mt19937 rng(5);
+  for (auto& c : colours) c = static_cast<std::uint32_t>(rng());
+  colours[255] = 0;
+  for (const auto& [w, h, mixed] : {std::tuple{1, 5, false}, {7, 3, true}, {9, 4000, false}, {1003, 70, false}, {1003, 70, true}}) {
+    INFO(w << " x " << h << (mixed ? ", every index" : ", indices 0..6 and 255"));
+    const auto n = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    std::vector<std::uint8_t> index(n);
+    for (std::size_t j = 0; j < n; ++j) {
+      const auto r = rng();
+      index[j] = r % 5 == 0 ? 255 : static_cast<std::uint8_t>(r % 7);
+      if (mixed && r % 13 == 0) index[j] = static_cast<std::uint8_t>(rng());
+    }
+    std::vector<std::uint8_t> rgba(n * 4);
+    for (std::size_t j = 0; j < n; ++j) std::memcpy(&rgba[4 * j], &colours[index[j]], 4);
+    const std::string png = encode_png_indexed(index.data(), w, h, colours, 600, 300);
+    CHECK(png == encode_png_rgba(rgba.data(), w, h, 600, 300));
+    CHECK(decode_png_rgba(png, "indexed.png").pixels == rgba);
+  }
+  const std::uint8_t one = 0;
+  check_message(error_of([&] { encode_png_indexed(&one, 1, 0, colours, 600, 300); }), {"1 x 0", "expected a positive"});
+  check_message(error_of([&] { encode_png_indexed(&one, 1, 1, colours, 600, 300, 10); }), {"level 10", "expected 0..9"});
 }
 
 TEST_CASE("encode_png_rgba gives the same bytes from many threads", "[io][stack][png]") {

@@ -466,14 +466,49 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
             g.dither_paint(y, c, p, colours, o, k);
           }
         }
+        // The same groups as material indices (dither): painted, the same pixels and counts.
+        std::vector<std::vector<std::uint8_t>> idx(layers, std::vector<std::uint8_t>(cell[0].size(), 9));
+        std::vector<std::vector<std::int64_t>> idx_counts(layers, std::vector<std::int64_t>(static_cast<std::size_t>(nm), 0));
+        for (int l0 = 0; l0 < layers; l0 += size) {
+          const int n = std::min(size, layers - l0);
+          g.begin(n);
+          for (int y = 0; y < ny; ++y) {
+            if (row_skipped(y)) continue;
+            const std::size_t at = static_cast<std::size_t>(y) * nx;
+            const std::int32_t* c[8];
+            const float* p[8];
+            std::uint8_t* o[8];
+            std::int64_t* k[8];
+            for (int i = 0; i < n; ++i) {
+              c[i] = cell[l0 + i].data() + at;
+              p[i] = props[l0 + i].data() + at * np;
+              o[i] = idx[l0 + i].data() + at;
+              k[i] = idx_counts[l0 + i].data();
+            }
+            g.dither(y, c, p, o, k);
+          }
+        }
         for (int l = 0; l < layers; ++l) {
           INFO("nx " << nx << ", " << nm << " materials, groups of " << size << ", layer " << l);
           // Rows skipped stay as they were (9): the same rows are compared.
           for (int y = 0; y < ny; ++y)
-            if (row_skipped(y))
+            if (row_skipped(y)) {
               std::fill(got[l].begin() + 4 * y * nx, got[l].begin() + 4 * (y + 1) * nx, 0);
+              std::fill(idx[l].begin() + y * nx, idx[l].begin() + (y + 1) * nx, void_material);
+            }
           CHECK(got[l] == want[l]);
           CHECK(got_counts[l] == want_counts[l]);
+          std::vector<std::uint8_t> painted(idx[l].size() * 4);
+          bool indices_ok = true;
+          for (std::size_t v = 0; v < idx[l].size(); ++v) {
+            const bool skipped = row_skipped(static_cast<int>(v) / nx);
+            indices_ok = indices_ok && (idx[l][v] < nm || idx[l][v] == void_material) &&
+                         (skipped || (idx[l][v] == void_material) == (cell[l][v] < 0));
+            std::memcpy(&painted[4 * v], &colours[idx[l][v]], 4);
+          }
+          CHECK(indices_ok);
+          CHECK(painted == want[l]);
+          CHECK(idx_counts[l] == want_counts[l]);
         }
       }
     }

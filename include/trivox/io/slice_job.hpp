@@ -5,13 +5,17 @@
 /// A TBB pipeline with a bounded number of layers in flight: layers are sampled in parallel band
 /// by band (slice::LayerSampler), mapped to material fractions (slice::MaterialMapper), dithered
 /// (slice::LayerDitherer) and painted in palette colours, the three in one pass per row
-/// (LayerDitherer::dither_paint), and encoded to PNG in memory; an in-order
+/// (LayerDitherer::dither_paint), and encoded to PNG in memory; on the colour path up to 8 layers
+/// are dithered together (slice::LayerGroupDitherer) into material indices that the encoder
+/// paints (encode_png_indexed); an in-order
 /// stage writes each slice to a temporary name and renames it. ConfigFile.xml is written last,
 /// after a sync, so an interrupted job never looks complete. The manifest (manifest.hpp) is
 /// rewritten every few seconds after a sync; it lets a killed job resume (`resume`: listed layers
 /// whose SHA-256 still matches are kept) and a job run as shards (`shard`: a range of whole
 /// 8-layer blocks, merged by merge_job). Memory: per worker one layer of RGBA pixels
-/// (width x height x 4 bytes) plus one band of samples; it does not grow with the layer count.
+/// (width x height x 4 bytes), or on the grouped path 8 layers of indices (8 bytes per pixel,
+/// grouping only where those fit in 1 GiB over all workers), plus one band of samples per layer;
+/// it does not grow with the layer count.
 /// Output is byte-identical for any thread count (every layer depends on its own inputs only).
 /// Masalha, Cirillo & Elber 2021, Sec. 8 (slicing for VoxelPrint).
 #pragma once

@@ -136,8 +136,8 @@ private:
 /// chosen there, so only the five are carried), on an x86-64 CPU with AVX2.
 ///
 /// Cost per row: the layers' cells and properties transposed into lanes (8 x 8 block transposes),
-/// about 230 vector instructions per column for all the layers together, and the painted pixels
-/// transposed back: 4.2-4.4 ns per voxel of the bench job against 6.5 for one layer at a time
+/// about 230 vector instructions per column for all the layers together, and the choices
+/// transposed back (as RGBA pixels, or as one-byte material indices): 4.2-4.4 ns per voxel of the bench job against 6.5 for one layer at a time
 /// (docs/materials.md). Memory: 2 (nx + 2) * 40 floats of error and 8 (np + 2) floats per column
 /// of transposed rows. One object per thread.
 class LayerGroupDitherer {
@@ -168,11 +168,22 @@ public:
   void dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
                     const std::array<std::uint32_t, 256>& colours, std::uint8_t* const* rgba,
                     std::int64_t* const* counts);
+  /// The same choices as material indices (LayerDitherer::dither of the mapper's fractions):
+  /// one byte per voxel instead of four, what the print job keeps of a group's layers until they
+  /// are encoded (io::encode_png_indexed paints them).
+  /// @param index  per layer: nx material indices written (void_material for void voxels)
+  /// Other parameters and errors as dither_paint.
+  void dither(int row, const std::int32_t* const* cell, const float* const* props, std::uint8_t* const* index,
+              std::int64_t* const* counts);
 
   int layers() const noexcept { return layers_; }
   int nx() const noexcept { return nx_; }
 
 private:
+  /// One row of the group through the kernel: table[choice] (choice 0..4, 7 for void) per
+  /// column and lane into chosen_, the counts added.
+  void row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
+            std::int64_t* const* counts);
   int nx_, np_, ir_ = 0, ig_ = 0, ib_ = 0;
   int layers_ = 0;
   int next_row_ = 0;
@@ -182,10 +193,9 @@ private:
   std::vector<float> error_;          // 2 halves of (nx + 2) * 40: [column][material][lane]
   std::vector<float> props_;          // nx * np * 8: [column][property][lane], the row in progress
   std::vector<std::int32_t> cell_;    // (nx + 2) * 8: [column + 1][lane], pads void
-  std::vector<std::int32_t> chosen_;  // nx * 8: [column][lane], the painted RGBA
+  std::vector<std::int32_t> chosen_;  // nx * 8: [column][lane], the painted RGBA or the index
   std::vector<float> no_props_;       // nx * np zeros, and nx void cells: lanes without a layer
   std::vector<std::int32_t> no_cells_;
-  std::vector<std::uint8_t> scratch_;  // nx * 4: their painted row
 };
 
 }  // namespace trivox::slice
