@@ -228,34 +228,39 @@ using V8d = double __attribute__((vector_size(64)));
 /// the values (out[lane * m + h]). Contracts u, then v, then w, every step one multiply-add of
 /// eight lanes; each lane's floats are those of the same operations in the same order, whatever
 /// the vector width. OU, OV, OW as geom_kernel's.
-template <int OU, int OV, int OW>
+/// Four doubles as one vector (one AVX register): props8_body's operations on the first four
+/// lanes, for chunks of at most four points (the same floats lane by lane, at half the work).
+using V4d = double __attribute__((vector_size(32)));
+
+template <int OU, int OV, int OW, class V = V8d>
 [[gnu::always_inline]] inline void props8_body(const double* net, int nc, int H, int m, const std::array<int, 3>& ord,
                                                const double (*s)[8], double* out) {
   constexpr int MU = OU ? OU : max_order, MV = OV ? OV : max_order, MW = OW ? OW : max_order;
+  constexpr int L = sizeof(V) / sizeof(double);
   const int ou = OU ? OU : ord[0], ov = OV ? OV : ord[1], ow = OW ? OW : ord[2];
-  V8d su, sv, sw;
+  V su, sv, sw;
   std::memcpy(&su, s[0], sizeof su);
   std::memcpy(&sv, s[1], sizeof sv);
   std::memcpy(&sw, s[2], sizeof sw);
-  V8d Bu[MU], Bv[MV], Bw[MW];
+  V Bu[MU], Bv[MV], Bw[MW];
   bernstein<OU>(ou, su, Bu, nullptr);
   bernstein<OV>(ov, sv, Bv, nullptr);
   bernstein<OW>(ow, sw, Bw, nullptr);
   for (int h = 0; h < m; ++h) {
-    V8d S = {};
+    V S = {};
     for (int c = 0; c < ow; ++c) {
-      V8d T = {};
+      V T = {};
       for (int b = 0; b < ov; ++b) {
         const double* row = net + static_cast<std::ptrdiff_t>((c * ov + b) * ou) * nc + H + h;
-        V8d r = Bu[0] * row[0];
+        V r = Bu[0] * row[0];
         for (int a = 1; a < ou; ++a) r += Bu[a] * row[a * nc];
         T += Bv[b] * r;
       }
       S += Bw[c] * T;
     }
-    double v[8];
+    double v[L];
     std::memcpy(v, &S, sizeof v);
-    for (int l = 0; l < 8; ++l) out[l * m + h] = v[l];
+    for (int l = 0; l < L; ++l) out[l * m + h] = v[l];
   }
 }
 
@@ -276,6 +281,13 @@ template <int OU, int OV, int OW>
   props8_body<OU, OV, OW>(net, nc, H, m, ord, s, out);
 }
 
+/// props8_body on four lanes (s[d][0..3], out for four points), with AVX2.
+template <int OU, int OV, int OW>
+[[gnu::target("avx2")]] void props4_avx2(const double* net, int nc, int H, int m, const std::array<int, 3>& ord,
+                                         const double (*s)[8], double* out) {
+  props8_body<OU, OV, OW, V4d>(net, nc, H, m, ord, s, out);
+}
+
 /// props8 for the widest vectors the CPU has.
 template <int OU, int OV, int OW>
 Props8 props8_for() {
@@ -290,6 +302,7 @@ struct Kernels {
   Kernel all = nullptr;        ///< every coordinate's value
   Kernel all_first = nullptr;  ///< every coordinate with first partials (polynomial, nc <= 10)
   Props8 props = nullptr;      ///< the properties at eight points (polynomial)
+  Props8 props4 = nullptr;     ///< the same at four points (AVX2; else null)
 };
 
 template <int OU, int OV, int OW, int H>
@@ -297,6 +310,8 @@ Kernels kernels_for(int nc) {
   constexpr bool o4 = OU == 4 && OV == 4 && OW == 4;
   Kernels k{geom_kernel<OU, OV, OW, H, true>, geom_kernel<OU, OV, OW, H, false>, value_kernel<OU, OV, OW, 0>, nullptr,
             H == 3 ? props8_for<OU, OV, OW>() : nullptr};
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (H == 3 && avx2) k.props4 = props4_avx2<OU, OV, OW>;
   [&]<int... I>(std::integer_sequence<int, I...>) {
     (((nc == I + 3) ? (k.all = value_kernel<OU, OV, OW, I + 3>,
                        k.all_first = H != 3 ? nullptr : o4 ? first_o4_kernel<I + 3>() : geom_kernel<OU, OV, OW, I + 3, true, I + 3>, 0)
@@ -1549,7 +1564,7 @@ void Locator::piece_properties(int piece, const Vec3* t, int n, double* out) con
     for (int j = 0; j < n; ++j) D.eval_all(pc, t[j], buf.data(), x, out + static_cast<std::size_t>(j) * static_cast<std::size_t>(D.m));
     return;
   }
-  const Props8 kernel = pc.k.props;
+  const Props8 kernel = pc.k.props, kernel4 = pc.k.props4;
   const double* net = D.pool.data() + pc.net;
   const auto um = static_cast<std::size_t>(D.m);
   double s[3][8], buf[8 * Expansion::max_props];
@@ -1565,7 +1580,7 @@ void Locator::piece_properties(int piece, const Vec3* t, int n, double* out) con
       const Vec3& p = t[j0 + std::min(l, k - 1)];  // spare lanes repeat the last point
       for (std::size_t d = 0; d < 3; ++d) s[d][l] = (p[d] - pc.lo[d]) * pc.inv_len[d];
     }
-    kernel(net, pc.nc, pc.H, D.m, pc.order, s, vals);
+    (k <= 4 && kernel4 ? kernel4 : kernel)(net, pc.nc, pc.H, D.m, pc.order, s, vals);  // a short chunk: half the lanes
     std::copy_n(vals, static_cast<std::size_t>(k) * um, out + static_cast<std::size_t>(j0) * um);
   }
 }

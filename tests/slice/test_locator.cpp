@@ -209,7 +209,8 @@ TEST_CASE("locate: expansions equal the spline's first partials, and step bounds
 TEST_CASE("locate: a piece's properties at many points equal the spline's, also past the piece's box") {
   // Orders (4, 4, 4) with two pieces per direction (a kernel with the orders at compile time)
   // and (5, 4, 6) (the run-time orders); 1, 7, 8, 9 and 20 points (whole and partial groups of
-  // eight lanes).
+  // eight lanes; chunks of up to four points take a four-lane kernel with AVX2), and each point
+  // alone gives the same floats as in a chunk of eight (the same operations lane by lane).
   auto a = curved_tricubic();
   for (int d = 0; d < 3; ++d) a = spline::refine_uniform(a, d, 1);
   auto b = spline::elevate(spline::elevate(curved_tricubic(), 0, 1), 2, 2);
@@ -218,7 +219,7 @@ TEST_CASE("locate: a piece's properties at many points equal the spline's, also 
     const slice::Locator loc(m);
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> U(0, 1);
-    for (int n : {1, 7, 8, 9, 20}) {
+    for (int n : {1, 3, 4, 5, 7, 8, 9, 12, 20}) {
       slice::Expansion e;
       REQUIRE(loc.expand(0, {U(rng), U(rng), U(rng)}, e));
       const auto& bd = loc.step_bounds(e.piece);
@@ -230,6 +231,9 @@ TEST_CASE("locate: a piece's properties at many points equal the spline's, also 
       for (int j = 0; j < n; ++j) {
         const auto x = cell.eval(t[static_cast<std::size_t>(j)]);
         for (int h = 0; h < 3; ++h) CHECK(v[static_cast<std::size_t>(j * 3 + h)] == Approx(x[static_cast<std::size_t>(3 + h)]).margin(1e-12));
+        double alone[3];
+        loc.piece_properties(e.piece, &t[static_cast<std::size_t>(j)], 1, alone);
+        for (int h = 0; h < 3; ++h) CHECK(alone[h] == v[static_cast<std::size_t>(j * 3 + h)]);
       }
     }
   }
