@@ -11,9 +11,12 @@
 // 3. Peak memory of a full-tray-width J750 layer (11,575 x 4,606 px): the model scaled to the
 //    tray (490 x 390 mm) and to `tray_layers` layers; ru_maxrss after the job (run first).
 //
-// Usage: trivox_bench_slice [MODEL [LAYERS_FOR_STEP_1 [TRAY_LAYERS [THREADS]]]]
+// Usage: trivox_bench_slice [MODEL [LAYERS_FOR_STEP_1 [TRAY_LAYERS [THREADS [REPEATS]]]]]
 //   LAYERS_FOR_STEP_1: scale the model's height to this many J750 layers (0: keep its height).
 //   TRAY_LAYERS: 0 skips step 3. THREADS (default 2): for step 1 and its floor.
+//   REPEATS (default 5): step 1's job and floor each run this many times, alternating (job,
+//   floor, job, floor, ...), so that a shared machine's slow spells fall on both alike; the
+//   ratio is that of the medians, and the minima and their ratio are printed too.
 // With TRIVOX_BENCH_JOB_ONLY=1 only the job of step 1 runs (for callgrind: repeatable
 // instruction counts of the job alone).
 #include <sys/resource.h>
@@ -81,6 +84,7 @@ int main(int argc, char** argv) {
   const int layers = argc > 2 ? std::atoi(argv[2]) : 0;
   const int tray_layers = argc > 3 ? std::atoi(argv[3]) : 2;
   const int threads = argc > 4 ? std::max(1, std::atoi(argv[4])) : 2;
+  const int repeats = argc > 5 ? std::max(1, std::atoi(argv[5])) : 5;
   const char* job_only_env = std::getenv("TRIVOX_BENCH_JOB_ONLY");
   const bool job_only = job_only_env && std::string(job_only_env) == "1";
   const fs::path tmp = fs::temp_directory_path() / ("trivox-bench-slice-" + std::to_string(getpid()));
@@ -100,14 +104,14 @@ int main(int argc, char** argv) {
                 s.seconds, s.voxels / s.seconds);
     std::printf("peak memory of the tray job (ru_maxrss): %.1f MB\n", ru.ru_maxrss / 1024.0);
   }
-  // 1. The job against the floor.
-  const auto job = run(model, tmp / "job", threads);
+  // 1. The job against the floor, alternating.
+  const auto job0 = run(model, tmp / "job", threads);
   if (job_only) {
-    std::printf("job: %d x %d x %d, %.3f s, pipeline %.3f s, stages (ns per voxel):", job.grid.count[0], job.grid.count[1],
-                job.grid.count[2], job.seconds, job.pipeline_seconds);
-    for (std::size_t i = 0; i < job.stage_seconds.size(); ++i)
-      std::printf(" %s %.1f", io::slice_stage_names[i], 1e9 * job.stage_seconds[i] / static_cast<double>(job.voxels));
-    std::printf(", outside the stages %.3f thread-s\n", outside_stages(job, threads));
+    std::printf("job: %d x %d x %d, %.3f s, pipeline %.3f s, stages (ns per voxel):", job0.grid.count[0],
+                job0.grid.count[1], job0.grid.count[2], job0.seconds, job0.pipeline_seconds);
+    for (std::size_t i = 0; i < job0.stage_seconds.size(); ++i)
+      std::printf(" %s %.1f", io::slice_stage_names[i], 1e9 * job0.stage_seconds[i] / static_cast<double>(job0.voxels));
+    std::printf(", outside the stages %.3f thread-s\n", outside_stages(job0, threads));
     fs::remove_all(tmp);
     return 0;
   }
@@ -118,9 +122,9 @@ int main(int argc, char** argv) {
     names.push_back(cfg.slice_name(i));
     images.push_back(io::decode_png_rgba(io::read_file(tmp / "job" / names.back()), names.back()));
   }
-  fs::create_directories(tmp / "floor");
-  double floor_s;
-  {
+  const auto floor_once = [&] {
+    fs::remove_all(tmp / "floor");
+    fs::create_directories(tmp / "floor");
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
     const auto t0 = Clock::now();
     tbb::parallel_for(std::size_t{0}, images.size(), [&](std::size_t i) {
@@ -130,9 +134,25 @@ int main(int argc, char** argv) {
                                 io::Durability::deferred);
     });
     io::sync_folder_contents(tmp / "floor");  // as the job does before its ConfigFile.xml
-    floor_s = since(t0);
+    return since(t0);
+  };
+  // The first job above warmed the caches and wrote the reference slices; these are timed.
+  std::vector<io::SliceJobSummary> jobs;
+  std::vector<double> floors;
+  for (int r = 0; r < repeats; ++r) {
+    jobs.push_back(run(model, tmp / "job", threads));
+    floors.push_back(floor_once());
   }
-  std::printf("trivox bench_slice: %s, J750 600 x 300 dpi, 27 um layers, %d threads\n", model_path.c_str(), threads);
+  std::vector<std::size_t> by_time(jobs.size());
+  for (std::size_t i = 0; i < by_time.size(); ++i) by_time[i] = i;
+  std::sort(by_time.begin(), by_time.end(), [&](std::size_t a, std::size_t b) { return jobs[a].seconds < jobs[b].seconds; });
+  const auto& job = jobs[by_time[by_time.size() / 2]];  // the median job (the upper one of an even count)
+  std::vector<double> sorted_floors = floors;
+  std::sort(sorted_floors.begin(), sorted_floors.end());
+  const double floor_s = sorted_floors[sorted_floors.size() / 2];
+  const double job_min = jobs[by_time.front()].seconds, floor_min = sorted_floors.front();
+  std::printf("trivox bench_slice: %s, J750 600 x 300 dpi, 27 um layers, %d threads, medians of %d alternating runs\n",
+              model_path.c_str(), threads, repeats);
   std::printf("%-44s %12s %14s %8s\n", "step", "seconds", "voxels/s", "ratio");
   std::printf("%-44s %12.3f %14.4g %8s\n",
               ("job: " + std::to_string(job.grid.count[0]) + " x " + std::to_string(job.grid.count[1]) + " x " +
@@ -141,9 +161,13 @@ int main(int argc, char** argv) {
               job.seconds, job.voxels / job.seconds, "");
   std::printf("%-44s %12.3f %14.4g %8.2f\n", "floor: encode + write the same PNGs", floor_s, job.voxels / floor_s,
               job.seconds / floor_s);
+  std::printf("minima: job %.3f s, floor %.3f s, ratio %.2f; all runs (job/floor):", job_min, floor_min,
+              job_min / floor_min);
+  for (std::size_t r = 0; r < jobs.size(); ++r) std::printf(" %.3f/%.3f", jobs[r].seconds, floors[r]);
+  std::printf("\n");
   std::printf("per layer: job %.2f ms, floor %.2f ms\n", 1e3 * job.seconds / job.grid.count[2], 1e3 * floor_s / job.grid.count[2]);
   std::printf("inversion failures: %lld\n", static_cast<long long>(job.inversion_failures));
-  std::printf("job stages, thread-seconds (ns per voxel):");
+  std::printf("median job's stages, thread-seconds (ns per voxel):");
   for (std::size_t i = 0; i < job.stage_seconds.size(); ++i)
     std::printf(" %s %.3f (%.1f)", io::slice_stage_names[i], job.stage_seconds[i],
                 1e9 * job.stage_seconds[i] / static_cast<double>(job.voxels));
