@@ -696,6 +696,14 @@ struct GroupLoop {
     acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
     acc_fwd[k] = _mm256_mul_ps(w[3], err);
   }
+  /// Adds the 6-bit fields of packed (group_kernel's counts) to cnt and clears them.
+  [[gnu::target("avx2"), gnu::always_inline]] void unpack_counts(__m256i& packed, int& n) {
+    const __m256i field = _mm256_set1_epi32(63);
+    for (int k = 0; k < K; ++k)
+      cnt[k] = _mm256_add_epi32(cnt[k], _mm256_and_si256(_mm256_srli_epi32(packed, 6 * k), field));
+    packed = _mm256_setzero_si256();
+    n = 0;
+  }
   /// After the row: its last two columns' errors for the next row, and the counts.
   [[gnu::target("avx2"), gnu::always_inline]] void finish() {
     for (int k = 0; k < K; ++k) {
@@ -722,6 +730,13 @@ struct GroupLoop {
   GroupLoop g(a);
   const __m256 none = g.none, one = g.one, zero = g.zero;
   const __m256i seven = g.seven, minus1 = g.minus1;
+  // The counts in one vector of 6-bit fields (material k's at bit 6 k of its lane), unpacked
+  // into g.cnt before a field can overflow: with 16 vector registers, five count vectors
+  // would spill (AVX2 only; AVX-512's kernel has 32).
+  const __m256i count_step = _mm256_setr_epi32(1, 1 << 6, 1 << 12, 1 << 18, 1 << 24, 0, 0, 0);
+  constexpr int packed_max = 63;
+  __m256i packed = _mm256_setzero_si256();
+  int in_packed = 0;
   for (int t = 0; t < g.nx; ++t, g.x += g.dir) {
     const std::ptrdiff_t xs = g.x;
     float* d_back;
@@ -762,12 +777,14 @@ struct GroupLoop {
     __m256 hit[K];
     for (int k = 0; k < K; ++k) hit[k] = _mm256_castsi256_ps(_mm256_cmpeq_epi32(idx, _mm256_set1_epi32(k)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_permutevar8x32_epi32(a.colours, idx));
+    packed = _mm256_add_epi32(packed, _mm256_permutevar8x32_epi32(count_step, idx));
+    if (++in_packed == packed_max) g.unpack_counts(packed, in_packed);
     for (int k = 0; k < K; ++k) {
       const __m256 h = _mm256_and_ps(hit[k], one);
-      g.cnt[k] = _mm256_sub_epi32(g.cnt[k], _mm256_castps_si256(hit[k]));  // a hit is -1 as int32
       g.diffuse(k, w, _mm256_and_ps(live, _mm256_sub_ps(v[k], h)), d_back);  // +0 in void lanes
     }
   }
+  g.unpack_counts(packed, in_packed);
   g.finish();
 }
 

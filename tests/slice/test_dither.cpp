@@ -403,7 +403,15 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
     WARN("this CPU has no AVX2: the print job dithers one layer at a time, the grouped kernel is not built for it");
     return;
   }
-  for (const int nx : {1, 2, 97}) {
+  // Rows of 300 hold more than 63 live columns (the AVX2 kernel's packed counts unpack midway);
+  // on a CPU with AVX-512 both kernels run (TRIVOX_NO_AVX512 picks the AVX2 one).
+  struct RestoreKernel {
+    ~RestoreKernel() { unsetenv("TRIVOX_NO_AVX512"); }
+  } restore;
+  for (const bool avx2_only : {false, true})
+  for (const int nx : {1, 2, 97, 300}) {
+    if (avx2_only) setenv("TRIVOX_NO_AVX512", "1", 1);
+    else unsetenv("TRIVOX_NO_AVX512");
     const int ny = 23, layers = 8;
     std::vector<std::vector<std::int32_t>> cell(layers, std::vector<std::int32_t>(static_cast<std::size_t>(nx) * ny, 0));
     std::vector<std::vector<float>> props(layers, std::vector<float>(cell[0].size() * np));
