@@ -690,7 +690,7 @@ struct GroupLoop {
   }
   /// Material k's error err at the column whose down-back neighbour is d_back, spread with the
   /// column's weights w (forward, down-back, down, down-forward).
-  [[gnu::target("avx2"), gnu::always_inline]] void diffuse(int k, const __m256 (&w)[4], __m256 err, float* d_back) {
+  [[gnu::target("avx2"), gnu::always_inline]] void diffuse(int k, const __m256* w, __m256 err, float* d_back) {
     carry[k] = _mm256_mul_ps(w[0], err);
     _mm256_storeu_ps(d_back + 8 * k, _mm256_add_ps(acc_here[k], _mm256_mul_ps(w[1], err)));
     acc_here[k] = _mm256_add_ps(acc_fwd[k], _mm256_mul_ps(w[2], err));
@@ -751,8 +751,13 @@ struct GroupLoop {
     const __m256 fwd = _mm256_castsi256_ps(_mm256_cmpgt_epi32(g.cells(xs + g.dir), minus1));
     const __m256 *w_with, *w_without;
     g.weights(t, w_with, w_without);
-    __m256 w[4];
-    for (int j = 0; j < 4; ++j) w[j] = _mm256_blendv_ps(w_without[j], w_with[j], fwd);
+    // The weights read from memory where they are: kept in registers, they spilled (and most
+    // columns have a forward neighbour in every lane, or in none).
+    const int fwd_lanes = _mm256_movemask_ps(fwd);
+    __m256 mixed[4];
+    const __m256* w = fwd_lanes == 0xff ? w_with : fwd_lanes == 0 ? w_without : mixed;
+    if (w == mixed)
+      for (int j = 0; j < 4; ++j) mixed[j] = _mm256_blendv_ps(w_without[j], w_with[j], fwd);
     __m256 f[K];
     g.fractions(xs, f);
 
