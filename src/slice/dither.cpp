@@ -536,82 +536,96 @@ struct GroupRow {
   __m256* counts;              // group_k vectors: per material, per lane, added to
 };
 
-/// 8 x 8 transposes: rows r0..r7 (8 floats each) into columns.
-[[gnu::target("avx2"), gnu::always_inline]] inline void transpose8(__m256& r0, __m256& r1, __m256& r2, __m256& r3, __m256& r4,
-                                                                   __m256& r5, __m256& r6, __m256& r7) noexcept {
+/// 4 x 4 transposes within each 128-bit half: in each half, rows r0..r3 (4 floats each) into
+/// columns.
+[[gnu::target("avx2"), gnu::always_inline]] inline void transpose4_halves(__m256& r0, __m256& r1, __m256& r2,
+                                                                          __m256& r3) noexcept {
   const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
   const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
-  const __m256 t4 = _mm256_unpacklo_ps(r4, r5), t5 = _mm256_unpackhi_ps(r4, r5);
-  const __m256 t6 = _mm256_unpacklo_ps(r6, r7), t7 = _mm256_unpackhi_ps(r6, r7);
-  const __m256 u0 = _mm256_shuffle_ps(t0, t2, 0x44), u1 = _mm256_shuffle_ps(t0, t2, 0xee);
-  const __m256 u2 = _mm256_shuffle_ps(t1, t3, 0x44), u3 = _mm256_shuffle_ps(t1, t3, 0xee);
-  const __m256 u4 = _mm256_shuffle_ps(t4, t6, 0x44), u5 = _mm256_shuffle_ps(t4, t6, 0xee);
-  const __m256 u6 = _mm256_shuffle_ps(t5, t7, 0x44), u7 = _mm256_shuffle_ps(t5, t7, 0xee);
-  r0 = _mm256_permute2f128_ps(u0, u4, 0x20), r1 = _mm256_permute2f128_ps(u1, u5, 0x20);
-  r2 = _mm256_permute2f128_ps(u2, u6, 0x20), r3 = _mm256_permute2f128_ps(u3, u7, 0x20);
-  r4 = _mm256_permute2f128_ps(u0, u4, 0x31), r5 = _mm256_permute2f128_ps(u1, u5, 0x31);
-  r6 = _mm256_permute2f128_ps(u2, u6, 0x31), r7 = _mm256_permute2f128_ps(u3, u7, 0x31);
+  r0 = _mm256_shuffle_ps(t0, t2, 0x44), r1 = _mm256_shuffle_ps(t0, t2, 0xee);
+  r2 = _mm256_shuffle_ps(t1, t3, 0x44), r3 = _mm256_shuffle_ps(t1, t3, 0xee);
+}
+
+/// Elements j..j+3 of row a in the low half and of row b in the high half (the 128-bit insert
+/// from memory is a load, not the cross-half shuffle an 8 x 8 transpose otherwise needs, which
+/// costs several cycles on AMD's Zen 1 and 3 on Intel's port 5).
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256 halves(const float* a, const float* b) noexcept {
+  return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(a)), _mm_loadu_ps(b), 1);
 }
 
 /// dst[j * 8 + l] = src[l][j] for j < n (4-byte elements): eight rows into column-major lanes.
+/// Per 8 columns: rows l and l + 4 paired in halves, then 4 x 4 transposes within the halves.
 [[gnu::target("avx2")]] void to_lanes(const void* const* src, std::size_t n, void* dst) noexcept {
   const float* s[8];
   for (int l = 0; l < 8; ++l) s[l] = static_cast<const float*>(src[l]);
   float* d = static_cast<float*>(dst);
   std::size_t j = 0;
-  for (; j + 8 <= n; j += 8) {
-    __m256 r0 = _mm256_loadu_ps(s[0] + j), r1 = _mm256_loadu_ps(s[1] + j), r2 = _mm256_loadu_ps(s[2] + j),
-           r3 = _mm256_loadu_ps(s[3] + j), r4 = _mm256_loadu_ps(s[4] + j), r5 = _mm256_loadu_ps(s[5] + j),
-           r6 = _mm256_loadu_ps(s[6] + j), r7 = _mm256_loadu_ps(s[7] + j);
-    transpose8(r0, r1, r2, r3, r4, r5, r6, r7);
+  for (; j + 4 <= n; j += 4) {
+    // Columns j..j+3: lane l of column c comes from row l (low half l < 4, high half l - 4).
+    __m256 r0 = halves(s[0] + j, s[4] + j), r1 = halves(s[1] + j, s[5] + j), r2 = halves(s[2] + j, s[6] + j),
+           r3 = halves(s[3] + j, s[7] + j);
+    transpose4_halves(r0, r1, r2, r3);
     float* o = d + j * 8;
     _mm256_storeu_ps(o, r0), _mm256_storeu_ps(o + 8, r1), _mm256_storeu_ps(o + 16, r2), _mm256_storeu_ps(o + 24, r3);
-    _mm256_storeu_ps(o + 32, r4), _mm256_storeu_ps(o + 40, r5), _mm256_storeu_ps(o + 48, r6), _mm256_storeu_ps(o + 56, r7);
   }
   for (; j < n; ++j)  // as bytes: the elements may be int32 (cells)
     for (int l = 0; l < 8; ++l) std::memcpy(d + j * 8 + static_cast<std::size_t>(l), s[l] + j, 4);
 }
 
-/// dst[l][j] = src[j * 8 + l] for j < n and l < lanes: the inverse of to_lanes.
+/// dst[l][j] = src[j * 8 + l] for j < n and l < lanes: the inverse of to_lanes (per 4 columns,
+/// 4 x 4 transposes within the halves, then each half stored to its row).
 [[gnu::target("avx2")]] void from_lanes(const void* src, std::size_t n, int lanes, void* const* dst) noexcept {
   const float* s = static_cast<const float*>(src);
   float* d[8];
   for (int l = 0; l < 8; ++l) d[l] = static_cast<float*>(dst[l]);
   std::size_t j = 0;
-  for (; j + 8 <= n; j += 8) {
+  for (; j + 4 <= n; j += 4) {
     const float* q = s + j * 8;
-    __m256 r[8];
-    for (int l = 0; l < 8; ++l) r[l] = _mm256_loadu_ps(q + 8 * l);
-    transpose8(r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]);
-    for (int l = 0; l < lanes; ++l) _mm256_storeu_ps(d[l] + j, r[l]);
+    __m256 r[4];
+    for (int c = 0; c < 4; ++c) r[c] = _mm256_loadu_ps(q + 8 * c);
+    transpose4_halves(r[0], r[1], r[2], r[3]);  // r[l]: row l's 4 columns low, row l + 4's high
+    for (int l = 0; l < 4 && l < lanes; ++l) _mm_storeu_ps(d[l] + j, _mm256_castps256_ps128(r[l]));
+    for (int l = 4; l < lanes; ++l) _mm_storeu_ps(d[l] + j, _mm256_extractf128_ps(r[l - 4], 1));
   }
   for (; j < n; ++j)
     for (int l = 0; l < lanes; ++l) std::memcpy(d[l] + j, s + j * 8 + static_cast<std::size_t>(l), 4);
 }
 
+/// The low bytes of 4 columns of lanes (q: 4 x 8 int32), per half transposed: bytes 4 l .. 4 l + 3
+/// of the low half are lane l's 4 columns, those of the high half lane l + 4's.
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256i low_bytes4(const std::int32_t* q) noexcept {
+  const __m256i low = _mm256_set1_epi32(0xff);
+  // Within a half: bytes 4 c + l (column c, lane l) to 4 l + c.
+  const __m256i turn = _mm256_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15, 0, 4, 8, 12, 1, 5, 9, 13, 2, 6,
+                                        10, 14, 3, 7, 11, 15);
+  __m256i c[4];
+  for (int i = 0; i < 4; ++i) c[i] = _mm256_and_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(q + 8 * i)), low);
+  // Per half: columns 0..3, 4 bytes each (the values fit: no saturation), then turned.
+  const __m256i p = _mm256_packus_epi16(_mm256_packus_epi32(c[0], c[1]), _mm256_packus_epi32(c[2], c[3]));
+  return _mm256_shuffle_epi8(p, turn);
+}
+
 /// dst[l][j] = the low byte of src[j * 8 + l] (int32) for j < n and l < lanes: from_lanes into
-/// bytes (material indices), each layer's eight columns packed by one byte shuffle.
+/// bytes (material indices). Per 8 columns: the low bytes packed (within halves) into one
+/// vector per 4 columns, 4 x 4 bytes transposed by one shuffle, and the two vectors' rows
+/// interleaved into 8-byte rows.
 [[gnu::target("avx2")]] void from_lanes_bytes(const void* src, std::size_t n, int lanes, std::uint8_t* const* dst) noexcept {
-  const float* s = static_cast<const float*>(src);
-  // Byte 0 of each 32-bit element into bytes 0..3 of its 128-bit half, then both halves' four
-  // into the low eight bytes.
-  const __m256i pick = _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, 0, 4, 8, 12, -1, -1, -1,
-                                        -1, -1, -1, -1, -1, -1, -1, -1, -1);
-  const __m256i join = _mm256_setr_epi32(0, 4, 1, 1, 1, 1, 1, 1);
+  const auto* s = static_cast<const std::int32_t*>(src);
   std::size_t j = 0;
   for (; j + 8 <= n; j += 8) {
-    const float* q = s + j * 8;
-    __m256 r[8];
-    for (int l = 0; l < 8; ++l) r[l] = _mm256_loadu_ps(q + 8 * l);
-    transpose8(r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7]);
+    const __m256i a = low_bytes4(s + j * 8), b = low_bytes4(s + j * 8 + 32);
+    // Per half, 8-byte rows: lo holds lanes 0, 1 (high half: 4, 5), hi lanes 2, 3 (6, 7).
+    const __m256i lo = _mm256_unpacklo_epi32(a, b), hi = _mm256_unpackhi_epi32(a, b);
+    const __m128i rows[4] = {_mm256_castsi256_si128(lo), _mm256_castsi256_si128(hi), _mm256_extracti128_si256(lo, 1),
+                             _mm256_extracti128_si256(hi, 1)};
     for (int l = 0; l < lanes; ++l) {
-      const __m256i b = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(_mm256_castps_si256(r[l]), pick), join);
-      _mm_storel_epi64(reinterpret_cast<__m128i*>(dst[l] + j), _mm256_castsi256_si128(b));
+      const __m128i r = rows[(l / 4) * 2 + (l % 4) / 2];
+      if (l % 2 == 0) _mm_storel_epi64(reinterpret_cast<__m128i*>(dst[l] + j), r);
+      else _mm_storeh_pd(reinterpret_cast<double*>(dst[l] + j), _mm_castsi128_pd(r));
     }
   }
-  const auto* si = static_cast<const std::int32_t*>(src);
   for (; j < n; ++j)
-    for (int l = 0; l < lanes; ++l) dst[l][j] = static_cast<std::uint8_t>(si[j * 8 + static_cast<std::size_t>(l)]);
+    for (int l = 0; l < lanes; ++l) dst[l][j] = static_cast<std::uint8_t>(s[j * 8 + static_cast<std::size_t>(l)]);
 }
 
 /// What the two group kernels share: the row's pointers and weights, the state carried along the
