@@ -788,11 +788,12 @@ struct GroupLoop {
     // The lowest material among equal maxima, in live lanes (void: 7): from the highest down,
     // each equal one replaces the choice (one of them equals the maximum, so K - 1 stands when
     // no lower one does); the hits are the lanes whose choice is k.
-    __m256i idx = _mm256_blendv_epi8(seven, _mm256_set1_epi32(K - 1), _mm256_castps_si256(live));
-    for (int k = K - 2; k >= 0; --k) {
-      const __m256 eq = _mm256_and_ps(_mm256_cmp_ps(masked[k], mv, _CMP_EQ_OQ), live);
-      idx = _mm256_blendv_epi8(idx, _mm256_set1_epi32(k), _mm256_castps_si256(eq));
-    }
+    // (Void lanes choose among their finite values too, and are set to 7 after: one blend
+    // instead of a mask per material.)
+    __m256i idx = _mm256_set1_epi32(K - 1);
+    for (int k = K - 2; k >= 0; --k)
+      idx = _mm256_blendv_epi8(idx, _mm256_set1_epi32(k), _mm256_castps_si256(_mm256_cmp_ps(masked[k], mv, _CMP_EQ_OQ)));
+    idx = _mm256_blendv_epi8(seven, idx, live_i);
     __m256 hit[K];
     for (int k = 0; k < K; ++k) hit[k] = _mm256_castsi256_ps(_mm256_cmpeq_epi32(idx, _mm256_set1_epi32(k)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(a.rgba + xs * 8), _mm256_permutevar8x32_epi32(a.colours, idx));
