@@ -644,12 +644,10 @@ template <int M>
     }
   const int blocks = n / 4;
   float* o = out;
-  for (int b = 0; b < blocks; ++b, o += w) {
-    const double fb = b;
+  double fb = 0.0;  // the block index, counted in doubles (exact), not converted per block
+  for (int b = 0; b < blocks; ++b, o += w, fb += 1.0)
     for (int k = 0; k < w; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
-  }
   const int rest = (n - 4 * blocks) * um;
-  const double fb = blocks;
   for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
 }
 
