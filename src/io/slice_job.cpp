@@ -43,12 +43,17 @@ std::string human_bytes(double b) {
 }
 
 void check_profile(const slice::PrintProfile& p) {
+  const auto text = [](double v) {  // as a user would type it: 0.027, not 0.027000
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
   if (!(std::isfinite(p.dpi_x) && std::isfinite(p.dpi_y) && p.dpi_x >= 10 && p.dpi_x <= 10000 && p.dpi_y >= 10 &&
         p.dpi_y <= 10000))
-    throw Error("--dpi " + std::to_string(p.dpi_x) + "," + std::to_string(p.dpi_y) +
+    throw Error("--dpi " + text(p.dpi_x) + "," + text(p.dpi_y) +
                 ": out of range; expected 10 to 10000 dots per inch in x and y");
   if (!(std::isfinite(p.layer_mm) && p.layer_mm >= 0.001 && p.layer_mm <= 10.0))
-    throw Error("--layer " + std::to_string(p.layer_mm) + ": out of range; expected a layer of 0.001 to 10 mm");
+    throw Error("--layer " + text(p.layer_mm) + ": out of range; expected a layer of 0.001 to 10 mm");
 }
 
 bool is_manifest_name(const std::string& name) {

@@ -77,8 +77,8 @@ PY
 # Refusals: exit 2 with the reason.
 expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never
 expect_fail "unknown printer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --printer j9000
-expect_fail "expected 10 to 10000" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x2" --dpi 0,100
-expect_fail "expected a layer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x3" --layer -1
+expect_fail "--dpi 0,100: out of range; expected 10 to 10000" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x2" --dpi 0,100
+expect_fail "--layer -1: out of range; expected a layer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x3" --layer -1
 expect_fail "expected fs, stochastic or none" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x4" --dither blue
 expect_fail "voxels" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x5" --max-voxels 100
 echo '{"materials": 3}' > "$tmp/bad-palette.json"
