@@ -7,6 +7,7 @@
 #endif
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -788,6 +789,10 @@ private:
         if (act[next].i0 > i) i = act[next].i0;
       }
       while (next < g1 && act[next].i0 <= i) span_end = std::max(span_end, act[next++].i1);
+      // A run claimed up to span_end + 1 can leave i past every leaf opened so far (and past the
+      // row's last voxel: i = nx); those leaves end before i, so look at the next ones.
+      if (i > span_end) continue;
+      assert(i <= span_end && span_end < grid_.count[0]);  // owner[i], props, uvw within the row
       if (i != prev_i + 1) chain.n = check_run = 0;
       // 1. Certified stepping: a run of voxels without any evaluation.
       if (cur < 0 || !anchors_[static_cast<std::size_t>(cur)].covers(l, i)) {
