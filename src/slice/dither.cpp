@@ -547,14 +547,14 @@ struct GroupRow {
 }
 
 /// Elements j..j+3 of row a in the low half and of row b in the high half (the 128-bit insert
-/// from memory is a load, not the cross-half shuffle an 8 x 8 transpose otherwise needs, which
-/// costs several cycles on AMD's Zen 1 and 3 on Intel's port 5).
+/// from memory is a load, not the cross-half permute an 8 x 8 transpose otherwise needs: several
+/// micro-ops on AMD's Zen 1, a 3-cycle operation on Intel's one shuffle port).
 [[gnu::target("avx2"), gnu::always_inline]] inline __m256 halves(const float* a, const float* b) noexcept {
   return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(a)), _mm_loadu_ps(b), 1);
 }
 
 /// dst[j * 8 + l] = src[l][j] for j < n (4-byte elements): eight rows into column-major lanes.
-/// Per 8 columns: rows l and l + 4 paired in halves, then 4 x 4 transposes within the halves.
+/// Per 4 columns: rows l and l + 4 paired in halves, then 4 x 4 transposes within the halves.
 [[gnu::target("avx2")]] void to_lanes(const void* const* src, std::size_t n, void* dst) noexcept {
   const float* s[8];
   for (int l = 0; l < 8; ++l) s[l] = static_cast<const float*>(src[l]);
