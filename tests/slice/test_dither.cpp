@@ -11,6 +11,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "trivox/error.hpp"
@@ -408,8 +409,10 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
   struct RestoreKernel {
     ~RestoreKernel() { unsetenv("TRIVOX_NO_AVX512"); }
   } restore;
+  std::vector<std::pair<bool, int>> cases;  // (AVX2 kernel only, voxels per row)
   for (const bool avx2_only : {false, true})
-  for (const int nx : {1, 2, 97, 300}) {
+    for (const int n : {1, 2, 97, 300}) cases.emplace_back(avx2_only, n);
+  for (const auto& [avx2_only, nx] : cases) {
     if (avx2_only) setenv("TRIVOX_NO_AVX512", "1", 1);
     else unsetenv("TRIVOX_NO_AVX512");
     const int ny = 23, layers = 8;
