@@ -524,6 +524,7 @@ constexpr int group_k = 5, group_stride = group_k * 8;
 /// per column, one 8-float (or int32) vector whose lane l belongs to the group's layer l.
 struct GroupRow {
   int nx;
+  int lo, hi;                  // the columns to visit (every lane void outside them; lo <= hi)
   bool left_to_right;
   const __m256 (*weights)[4];  // per neighbour-availability mask, broadcast
   const std::int32_t* cell;    // (nx + 2) * 8: column c at (c + 1) * 8; the pads are void
@@ -628,6 +629,41 @@ struct GroupRow {
     for (int l = 0; l < lanes; ++l) dst[l][j] = static_cast<std::uint8_t>(s[j * 8 + static_cast<std::size_t>(l)]);
 }
 
+/// Widens [lo, hi] to hold every i < n with c[i] >= 0 (a layer's live voxels in its row), looking
+/// only outside [lo, hi] (lo > hi: empty so far): from the left up to lo, from the right down to
+/// hi, eight cells per compare.
+[[gnu::target("avx2")]] void widen_live_span(const std::int32_t* c, int n, int& lo, int& hi) noexcept {
+  const __m256i minus1 = _mm256_set1_epi32(-1);
+  const int left_end = std::min(lo, n);  // scan [0, left_end)
+  int i = 0;
+  for (; i + 8 <= left_end; i += 8) {
+    const int m = _mm256_movemask_ps(
+        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + i)), minus1)));
+    if (m != 0) break;
+  }
+  for (; i < left_end; ++i)
+    if (c[i] >= 0) {
+      lo = i;
+      break;
+    }
+  if (lo > hi) hi = lo < n ? lo : -1;  // the first live one found (or none at all so far)
+  if (hi < 0) {
+    lo = n;  // no live voxel left of n: the whole row is void so far
+    return;
+  }
+  int j = n;  // scan (hi, n) from the right
+  for (; j - 8 > hi; j -= 8) {
+    const int m = _mm256_movemask_ps(
+        _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + j - 8)), minus1)));
+    if (m != 0) break;
+  }
+  for (--j; j > hi; --j)
+    if (c[j] >= 0) {
+      hi = j;
+      break;
+    }
+}
+
 /// What the two group kernels share: the row's pointers and weights, the state carried along the
 /// row (per material the error for the next voxel and the two accumulating in the next row), and
 /// the steps that do not depend on how the lanes' masks are held.
@@ -649,14 +685,19 @@ struct GroupLoop {
   const __m256i seven = _mm256_set1_epi32(7), minus1 = _mm256_set1_epi32(-1);
   const __m256i void_px = _mm256_permutevar8x32_epi32(a.colours, seven);  // the table's void entry in every lane
 
+  // The visit: columns lo..hi (or hi..lo), step t of the row's nx (t = 0 its first column,
+  // nx - 1 its last: the weights at the row's ends depend on t).
+  int t_begin, t_end;
+
   [[gnu::target("avx2"), gnu::always_inline]] explicit GroupLoop(const GroupRow& row)
-      : a(row), nx(row.nx), dir(row.left_to_right ? 1 : -1), x(row.left_to_right ? 0 : row.nx - 1), in(row.in + S),
+      : a(row), nx(row.nx), dir(row.left_to_right ? 1 : -1), x(row.left_to_right ? row.lo : row.hi), in(row.in + S),
         down(row.down + S), cell(row.cell + 8), np8(8 * static_cast<std::ptrdiff_t>(row.np)), pr(row.props + 8 * row.ir),
         pg(row.props + 8 * row.ig), pb(row.props + 8 * row.ib),
         first_with(row.weights[row.nx > 1 ? has_forward | has_down_forward : 0]),
         first_without(row.weights[row.nx > 1 ? has_down_forward : 0]),
         mid_with(row.weights[has_forward | has_down_back | has_down_forward]),
-        mid_without(row.weights[has_down_back | has_down_forward]), last_without(row.weights[row.nx > 1 ? has_down_back : 0]) {
+        mid_without(row.weights[has_down_back | has_down_forward]), last_without(row.weights[row.nx > 1 ? has_down_back : 0]),
+        t_begin(row.left_to_right ? row.lo : row.nx - 1 - row.hi), t_end(t_begin + row.hi - row.lo + 1) {
     for (int k = 0; k < K; ++k) {
       acc_here[k] = acc_fwd[k] = carry[k] = _mm256_setzero_ps();
       cnt[k] = _mm256_setzero_si256();
@@ -751,7 +792,7 @@ struct GroupLoop {
   constexpr int packed_max = 63;
   __m256i packed = _mm256_setzero_si256();
   int in_packed = 0;
-  for (int t = 0; t < g.nx; ++t, g.x += g.dir) {
+  for (int t = g.t_begin; t < g.t_end; ++t, g.x += g.dir) {
     const std::ptrdiff_t xs = g.x;
     float* d_back;
     const float* e = g.errors_in(xs, d_back);
@@ -819,7 +860,7 @@ using GroupKernel = void (*)(const GroupRow&);
   GroupLoop g(a);
   const __m256 none = g.none, one = g.one, zero = g.zero;
   const __m256i seven = g.seven, minus1 = g.minus1;
-  for (int t = 0; t < g.nx; ++t, g.x += g.dir) {
+  for (int t = g.t_begin; t < g.t_end; ++t, g.x += g.dir) {
     const std::ptrdiff_t xs = g.x;
     float* d_back;
     const float* e = g.errors_in(xs, d_back);
@@ -865,12 +906,12 @@ GroupKernel group_kernel_for() {
 
 /// One grouped row: the kernel on the job's buffers (plain pointers, so that callers need no
 /// AVX types), adding the choices of each material and lane to counts.
-[[gnu::target("avx2")]] void group_row(int nx, bool left_to_right, const float (*weights)[4][8], const std::int32_t* cell,
+[[gnu::target("avx2")]] void group_row(int nx, int lo, int hi, bool left_to_right, const float (*weights)[4][8], const std::int32_t* cell,
                                        const float* props, int np, int ir, int ig, int ib, const float* in, float* down,
                                        const std::int32_t* table, std::int32_t* rgba, float (*counts)[8]) {
   __m256 c[group_k];
   for (auto& v : c) v = _mm256_setzero_ps();
-  const GroupRow a{nx, left_to_right, reinterpret_cast<const __m256(*)[4]>(weights), cell, props, np, ir, ig, ib, in, down,
+  const GroupRow a{nx, lo, hi, left_to_right, reinterpret_cast<const __m256(*)[4]>(weights), cell, props, np, ir, ig, ib, in, down,
                    _mm256_loadu_si256(reinterpret_cast<const __m256i*>(table)), rgba, c};
   group_kernel_for()(a);
   for (int k = 0; k < group_k; ++k) _mm256_storeu_ps(counts[k], _mm256_add_ps(_mm256_loadu_ps(counts[k]), c[k]));
@@ -883,10 +924,11 @@ bool group_kernel_available() noexcept {
 
 #else
 bool group_kernel_available() noexcept { return false; }
+void widen_live_span(const std::int32_t*, int, int&, int&) noexcept {}
 void to_lanes(const void* const*, std::size_t, void*) noexcept {}
 void from_lanes(const void*, std::size_t, int, void* const*) noexcept {}
 void from_lanes_bytes(const void*, std::size_t, int, std::uint8_t* const*) noexcept {}
-void group_row(int, bool, const float (*)[4][8], const std::int32_t*, const float*, int, int, int, int, const float*, float*,
+void group_row(int, int, int, bool, const float (*)[4][8], const std::int32_t*, const float*, int, int, int, int, const float*, float*,
                const std::int32_t*, std::int32_t*, float (*)[8]) {}
 #endif  // TRIVOX_DITHER_AVX2
 
@@ -1103,39 +1145,68 @@ void LayerGroupDitherer::begin(int layers) {
                 ErrorKind::failed);
   layers_ = layers;
   next_row_ = 0;
-  std::fill(error_.begin(), error_.end(), 0.0f);
+  clear_errors();
 }
 
-void LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
+void LayerGroupDitherer::clear_errors() {
+  std::fill(error_.begin(), error_.end(), 0.0f);
+  for (auto& r : written_) r = {0, -1};
+}
+
+bool LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
                               std::int64_t* const* counts) {
   if (layers_ < 1) throw Error("dithering: a row before begin()", ErrorKind::failed);
   if (row < 0 || row < next_row_)
     throw Error("dithering: row " + std::to_string(row) + " after rows up to " + std::to_string(next_row_ - 1) +
                     "; expected increasing rows (error diffusion runs downwards)",
                 ErrorKind::failed);
-  if (row > next_row_) std::fill(error_.begin(), error_.end(), 0.0f);
+  if (row > next_row_) clear_errors();
   next_row_ = row + 1;
-  // The layers' rows into lanes (lanes without a layer: void cells, zero properties).
-  const auto nx = static_cast<std::size_t>(nx_), np = static_cast<std::size_t>(np_);
+  // The columns where some layer has a live voxel, [lo, hi]: outside them the kernel would only
+  // write void and pass no error (a void column drops what is aimed at it), so it visits these.
+  int lo = nx_, hi = -1;
+  for (int l = 0; l < layers_; ++l) widen_live_span(cell[l], nx_, lo, hi);
+  lo_ = lo, hi_ = hi;
+  // The error for the next row: the kernel writes columns lo - 1 .. hi + 1 (pads included), and
+  // the rest of that half must read as zero, as the whole-row kernel leaves it. Each half is
+  // zero outside the columns it last had written (written_), so only those are cleared.
+  const std::size_t half = error_.size() / 2;
+  const int d = row % 2 == 0 ? 1 : 0;  // the half written now
+  float* in = error_.data() + (d == 1 ? 0 : half);
+  float* down = error_.data() + (d == 1 ? half : 0);
+  auto clear = [&](int c0, int c1) {  // columns c0..c1 of down (-1 and nx: the pads)
+    if (c0 <= c1)
+      std::fill(down + static_cast<std::size_t>(c0 + 1) * group_stride, down + static_cast<std::size_t>(c1 + 2) * group_stride, 0.0f);
+  };
+  auto& [w0, w1] = written_[static_cast<std::size_t>(d)];
+  if (hi < 0) {
+    clear(w0, w1);
+    w0 = 0, w1 = -1;
+    return false;
+  }
+  clear(w0, std::min(w1, lo - 2));
+  clear(std::max(w0, hi + 2), w1);
+  w0 = lo - 1, w1 = hi + 1;
+  // The layers' live columns into lanes (lanes without a layer: void cells, zero properties),
+  // with void cells on either side (the kernel reads the forward neighbour's).
+  const auto n = static_cast<std::size_t>(hi - lo + 1), np = static_cast<std::size_t>(np_), ulo = static_cast<std::size_t>(lo);
   const void* cs[8];
   const void* ps[8];
   for (int l = 0; l < 8; ++l) {
     const bool used = l < layers_;
-    cs[l] = used ? static_cast<const void*>(cell[l]) : no_cells_.data();
-    ps[l] = used ? static_cast<const void*>(props[l]) : no_props_.data();
+    cs[l] = used ? static_cast<const void*>(cell[l] + ulo) : no_cells_.data();
+    ps[l] = used ? static_cast<const void*>(props[l] + ulo * np) : no_props_.data();
   }
-  to_lanes(cs, nx, cell_.data() + 8);
-  to_lanes(ps, nx * np, props_.data());
-  const std::size_t half = error_.size() / 2;
-  float* in = error_.data() + (row % 2 == 0 ? 0 : half);
-  float* down = error_.data() + (row % 2 == 0 ? half : 0);
+  std::fill_n(cell_.data() + ulo * 8, 8, -1);             // column lo - 1
+  std::fill_n(cell_.data() + (ulo + n + 1) * 8, 8, -1);   // column hi + 1
+  to_lanes(cs, n, cell_.data() + (ulo + 1) * 8);
+  to_lanes(ps, n * np, props_.data() + ulo * np * 8);
   float lane_counts[group_k][8] = {};
-  group_row(nx_, row % 2 == 0, weights_, cell_.data(), props_.data(), np_, ir_, ig_, ib_, in, down, table, chosen_.data(),
+  group_row(nx_, lo, hi, row % 2 == 0, weights_, cell_.data(), props_.data(), np_, ir_, ig_, ib_, in, down, table, chosen_.data(),
             lane_counts);
-  std::fill(in, in + group_stride, 0.0f);  // as fs_row
-  std::fill(in + half - group_stride, in + half, 0.0f);
   for (int l = 0; l < layers_; ++l)
     for (int k = 0; k < group_k; ++k) counts[l][k] += static_cast<std::int64_t>(lane_counts[k][l]);
+  return true;
 }
 
 void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
@@ -1146,18 +1217,32 @@ void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, 
   std::int32_t table[8] = {};
   for (int k = 0; k < group_k; ++k) table[k] = static_cast<std::int32_t>(colours[static_cast<std::size_t>(k)]);
   table[7] = static_cast<std::int32_t>(colours[void_material]);
-  row_(row, cell, props, table, counts);
+  const bool any = row_(row, cell, props, table, counts);
+  const auto nx = static_cast<std::size_t>(nx_);
+  const std::size_t lo = any ? static_cast<std::size_t>(lo_) : nx, hi = any ? static_cast<std::size_t>(hi_) : nx - 1;
   void* outs[8];
-  for (int l = 0; l < layers_; ++l) outs[l] = rgba[l];
-  from_lanes(chosen_.data(), static_cast<std::size_t>(nx_), layers_, outs);
+  for (int l = 0; l < layers_; ++l) {
+    for (std::size_t j = 0; j < lo; ++j) std::memcpy(rgba[l] + 4 * j, &colours[void_material], 4);
+    for (std::size_t j = hi + 1; j < nx; ++j) std::memcpy(rgba[l] + 4 * j, &colours[void_material], 4);
+    outs[l] = rgba[l] + 4 * lo;
+  }
+  if (any) from_lanes(chosen_.data() + lo * 8, hi - lo + 1, layers_, outs);
 }
 
 void LayerGroupDitherer::dither(int row, const std::int32_t* const* cell, const float* const* props, std::uint8_t* const* index,
                                 std::int64_t* const* counts) {
   const FlushDenormals flush;
   const std::int32_t table[8] = {0, 1, 2, 3, 4, 0, 0, void_material};
-  row_(row, cell, props, table, counts);
-  from_lanes_bytes(chosen_.data(), static_cast<std::size_t>(nx_), layers_, index);
+  const bool any = row_(row, cell, props, table, counts);
+  const auto nx = static_cast<std::size_t>(nx_);
+  const std::size_t lo = any ? static_cast<std::size_t>(lo_) : nx, hi = any ? static_cast<std::size_t>(hi_) : nx - 1;
+  std::uint8_t* outs[8];
+  for (int l = 0; l < layers_; ++l) {
+    std::fill(index[l], index[l] + lo, void_material);
+    std::fill(index[l] + hi + 1, index[l] + nx, void_material);
+    outs[l] = index[l] + lo;
+  }
+  if (any) from_lanes_bytes(chosen_.data() + lo * 8, hi - lo + 1, layers_, outs);
 }
 
 }  // namespace trivox::slice

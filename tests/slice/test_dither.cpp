@@ -397,7 +397,11 @@ TEST_CASE("dither_paint: one pass of map, dither and paint equals the three step
 TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone", "[dither]") {
   // Layers with their own colour fields (some out of reach, some NaN) and their own voids
   // (holes, a void row, void runs, a layer entirely void), in groups of 1 to 8 layers, rows
-  // given one at a time with a skipped row; also rows of 1 and 2 voxels.
+  // given one at a time with a skipped row; also rows of 1 and 2 voxels. In the shaped cases
+  // each layer is a disc of its own centre and radius (some reaching past the row's ends),
+  // with holes, so that the columns where any layer of a group is live grow and shrink from row
+  // to row (every third row narrower), and some rows are void in every layer (the kernel
+  // visits only those columns).
   const std::vector<std::string> names = {"r", "g", "b", "density"};
   const int np = 4;
   if (!LayerGroupDitherer::serves(DitherMode::fs, MaterialMapper(default_palette(), names))) {
@@ -409,10 +413,17 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
   struct RestoreKernel {
     ~RestoreKernel() { unsetenv("TRIVOX_NO_AVX512"); }
   } restore;
-  std::vector<std::pair<bool, int>> cases;  // (AVX2 kernel only, voxels per row)
-  for (const bool avx2_only : {false, true})
-    for (const int n : {1, 2, 97, 300}) cases.emplace_back(avx2_only, n);
-  for (const auto& [avx2_only, nx] : cases) {
+  struct Case {
+    bool avx2_only;  // the AVX2 kernel even where AVX-512 exists
+    int nx;          // voxels per row
+    bool shaped;     // discs, else scattered voids
+  };
+  std::vector<Case> cases;
+  for (const bool avx2_only : {false, true}) {
+    for (const int n : {1, 2, 97, 300}) cases.push_back({avx2_only, n, false});
+    for (const int n : {97, 300}) cases.push_back({avx2_only, n, true});
+  }
+  for (const auto& [avx2_only, nx, shaped] : cases) {
     if (avx2_only) setenv("TRIVOX_NO_AVX512", "1", 1);
     else unsetenv("TRIVOX_NO_AVX512");
     const int ny = 23, layers = 8;
@@ -429,7 +440,16 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
           props[l][v * np + 1] = (x % 13 == 0) ? std::nanf("") : 1.0f - s;
           props[l][v * np + 2] = (y % 4 == l % 4) ? u(rng) : 0.3f * s;
           props[l][v * np + 3] = u(rng);
-          if ((x * (l + 3) + y * 5) % 11 == 0 || y == 9 + l || (x > 20 + 3 * l && x < 30 + 4 * l) || l == 6) cell[l][v] = -1;
+          if (shaped) {
+            const double cx = nx * (0.15 + 0.1 * l), cy = 11.0 + (l % 3) - 1.0, rx = nx * (0.1 + 0.05 * l), ry = 5.0 + l % 4;
+            const double q = (x - cx) * (x - cx) / (rx * rx) + (y - cy) * (y - cy) / (ry * ry);
+            // Every third row narrower in every layer: the rows after it reach columns whose
+            // error half was last written two rows before (and must read as zero).
+            const bool narrow = y % 3 == 0 && (3 * x < nx || 3 * x > 2 * nx);
+            if (q >= 1.0 || narrow || (x * (l + 3) + y * 5) % 17 == 0) cell[l][v] = -1;
+          } else if ((x * (l + 3) + y * 5) % 11 == 0 || y == 9 + l || (x > 20 + 3 * l && x < 30 + 4 * l) || l == 6) {
+            cell[l][v] = -1;
+          }
         }
     for (const bool five : {false, true}) {
       Palette palette = default_palette();
@@ -500,7 +520,7 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
           }
         }
         for (int l = 0; l < layers; ++l) {
-          INFO("nx " << nx << ", " << nm << " materials, groups of " << size << ", layer " << l);
+          INFO("nx " << nx << (shaped ? " (discs)" : "") << ", " << nm << " materials, groups of " << size << ", layer " << l);
           // Rows skipped stay as they were (9): the same rows are compared.
           for (int y = 0; y < ny; ++y)
             if (row_skipped(y)) {

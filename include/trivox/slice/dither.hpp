@@ -135,10 +135,13 @@ private:
 /// five colour materials are indices 0..4 of at most 8 (the others never receive error or get
 /// chosen there, so only the five are carried), on an x86-64 CPU with AVX2.
 ///
-/// Cost per row: the layers' cells and properties transposed into lanes (8 x 8 block transposes),
-/// about 230 vector instructions per column for all the layers together, and the choices
-/// transposed back (as RGBA pixels, or as one-byte material indices): 4.2-4.4 ns per voxel of the bench job against 6.5 for one layer at a time
-/// (docs/materials.md). Memory: 2 (nx + 2) * 40 floats of error and 8 (np + 2) floats per column
+/// Cost per row: only the columns from the first to the last where some layer of the group has
+/// a live voxel are worked on (each layer's row scanned from both ends, eight cells per compare;
+/// outside them every lane is void, so there the kernel would only paint void and pass no
+/// error): the layers' cells and properties there transposed into lanes (4 x 4 transposes within
+/// 128-bit halves), about 140 vector instructions per column for all the layers together, and
+/// the choices transposed back (as RGBA pixels, or as one-byte material indices), void written
+/// around them: 4.0 ns per grid voxel of the bench job (docs/materials.md). Memory: 2 (nx + 2) * 40 floats of error and 8 (np + 2) floats per column
 /// of transposed rows. One object per thread.
 class LayerGroupDitherer {
 public:
@@ -181,12 +184,18 @@ public:
 
 private:
   /// One row of the group through the kernel: table[choice] (choice 0..4, 7 for void) per
-  /// column and lane into chosen_, the counts added.
-  void row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
+  /// column and lane into chosen_ for the columns lo_..hi_ where some layer has a live voxel
+  /// (every other column is void in every layer), the counts added; false when there are none.
+  bool row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
             std::int64_t* const* counts);
+  /// Zero error in both halves.
+  void clear_errors();
   int nx_, np_, ir_ = 0, ig_ = 0, ib_ = 0;
   int layers_ = 0;
   int next_row_ = 0;
+  int lo_ = 0, hi_ = -1;  // the last row's live columns (row_)
+  // Per half of error_, the columns (-1 and nx: the pads) written into it last; zero elsewhere.
+  std::array<std::array<int, 2>, 2> written_{{{0, -1}, {0, -1}}};
   // The fs weights per neighbour mask, each broadcast to 8 lanes (an AVX register each).
   alignas(32) float weights_[8][4][8] = {};
   // Column-major buffers (per column one vector, lane l = layer l of the group):
