@@ -269,6 +269,32 @@ public:
       a.lo[static_cast<std::size_t>(r)] = std::max(0, i - best_kn);
       a.hi[static_cast<std::size_t>(r)] = std::min(nx_ - 1, i + best_k);
     }
+    // The block's other rows, each with columns of its own: near a face that crosses the rows
+    // at a slant (a run's first voxels), the rectangle spans one or two rows, while the others
+    // are inside the cell a few columns to one side. Each is certified as a rectangle of one row
+    // (certified_with takes any ranges k0..k1, d..d as -kn = k0, kp = k1, -ln = lp = d), its
+    // columns first those where its parameters stay in the box (row_columns), within the
+    // anchor row's reach K, then fewer until certified. The property errors are the largest of
+    // all the rows' (sample_step).
+    if (best_up + best_down + 1 < rows_ && best_k >= 2) {
+      Errors worst = best_err;
+      for (int r = 0; r < rows_; ++r) {
+        if (r >= l - best_up && r <= l + best_down) continue;
+        const int dr = r - l;
+        for (int reach = best_k; reach >= 2; reach /= 2) {
+          int k0, k1;
+          if (!row_columns(dr, reach, i, k0, k1)) break;
+          if (certified(-k0, k1, -dr, dr)) {
+            a.lo[static_cast<std::size_t>(r)] = i + k0;
+            a.hi[static_cast<std::size_t>(r)] = i + k1;
+            worst.grad = std::max(worst.grad, err_.grad);
+            worst.taylor = std::max(worst.taylor, err_.taylor);
+            break;
+          }
+        }
+      }
+      best_err = worst;
+    }
     a.step = sample_step(best_err);
     return true;
   }
@@ -315,6 +341,26 @@ private:
         cap = std::min(cap, (dx_[j] > 0.0 ? up : down) * inv_dx_[j]);
     }
     return cap >= 1.0 ? static_cast<int>(std::floor(cap)) : 0;  // NaN: 0
+  }
+
+  /// The columns k0..k1 (relative to the anchor's column i, within the row and within -reach ..
+  /// reach) of the block row dr rows from the anchor's where its linear-model parameters stay
+  /// inside the bounds' box grown by the certificate's reach out of it (box_cap's terms);
+  /// false when there are none. A first guess for certified(): the certificate decides.
+  bool row_columns(int dr, int reach, int i, int& k0, int& k1) const {
+    double lo = -reach, hi = reach;
+    for (std::size_t j = 0; j < 3; ++j) {
+      const double y = dr * dy_[j];
+      if (!(inv_dx_[j] > 0.0)) continue;  // not bounded along the row (the certificate decides)
+      // k dx_j + y within [-room_lo, room_hi]
+      const double a = (-room_lo_[j] - y) * inv_dx_[j], b = (room_hi_[j] - y) * inv_dx_[j];
+      if (dx_[j] > 0.0) lo = std::max(lo, a), hi = std::min(hi, b);
+      else lo = std::max(lo, -b), hi = std::min(hi, -a);
+    }
+    if (!(lo <= hi)) return false;  // NaN: none
+    k0 = std::max(static_cast<int>(std::ceil(lo)), -i);
+    k1 = std::min(static_cast<int>(std::floor(hi)), nx_ - 1 - i);
+    return k0 <= k1;
   }
 
   /// The largest k in [0, cap] with ok(k) (ok is monotone: true up to some k), or -1: a little

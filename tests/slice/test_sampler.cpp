@@ -274,6 +274,21 @@ TEST_CASE("sampler: twisted column demo model, voxel volume within 1% of its qua
   CHECK(std::abs(vol - exact) < 0.01 * exact);
 }
 
+TEST_CASE("sampler: the contract holds at J750 pitch on the twisted column (anchors near slanted faces)") {
+  // The print job's bench model at printer pitch: its rings' faces cross the image rows at a
+  // slant, so a run's first anchor certifies each row of its block with columns of its own.
+  const auto m = io::load_model(models / "twisted_column.json");
+  const auto j750 = slice::printer_preset("j750");
+  const auto b = slice::model_bounds(m);
+  auto grid = VoxelGrid::covering(b[0], b[1], {j750.pitch_x(), j750.pitch_y(), j750.pitch_z()});
+  grid.origin[2] += 90 * grid.pitch[2];  // two layers inside the first ring
+  grid.count[2] = 2;
+  slice::SamplerOptions so;
+  so.keep_uvw = true;
+  const LayerSampler s(m, grid, so);
+  CHECK(check_contract(m, s, 3).inside > 300000);
+}
+
 TEST_CASE("sampler: overlapping cells, the first in file order wins") {
   const auto a = box_cell({0, 0, 0}, {2, 2, 2}, {1});
   const auto b = box_cell({1, 1, 1}, {3, 3, 3}, {2});

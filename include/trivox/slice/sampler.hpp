@@ -34,7 +34,12 @@
 ///   grow with the distance from the anchor, so an anchor certifies a rectangle of voxels across
 ///   the block's rows at once (its width found by doubling and bisection, up to where its
 ///   parameters leave the piece's box, and that width tried first where the box bound the last
-///   anchor); inside it a voxel costs a few multiply-adds. The next anchor is placed ahead of the
+///   anchor); inside it a voxel costs a few multiply-adds. Where the rectangle spans only some
+///   of the block's rows (a face crossing the rows at a slant, as at the start of most runs
+///   through the twisted column's rings), each other row is certified on its own, with the
+///   columns where its linear-model parameters stay in the piece's box (a one-row rectangle
+///   beside the anchor: the same bounds), so that one anchor still serves the whole block.
+///   The next anchor is placed ahead of the
 ///   first voxel not yet covered, by the reach of the last one, so that rectangles do not
 ///   overlap by half.
 /// - A voxel whose predicted parameters leave the cell's domain is first tried for a proof that
