@@ -190,7 +190,11 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const slice::MaterialMapper mapper(palette, model.properties);
   const slice::DitherMode mode = slice::parse_dither_mode(opt.dither);
 
-  const slice::LayerSampler sampler(model, grid, opt.sampler);
+  // Every dithering mode reads a voxel's cell before its properties, so void voxels' need not
+  // be cleared.
+  slice::SamplerOptions sampling = opt.sampler;
+  sampling.zero_void_props = false;
+  const slice::LayerSampler sampler(model, grid, sampling);
   const int nx = grid.count[0], ny = grid.count[1], nz = grid.count[2];
   const int nmat = mapper.materials();
   const int nprops = static_cast<int>(model.properties.size());

@@ -339,38 +339,9 @@ Kernels pick_kernels(const std::array<int, 3>& ord, int nc) {
 // Bezier restriction (de Casteljau), for building leaves: the net of a piece restricted to a
 // sub-box of its local [0,1]^3.
 
-/// Restricts the Bezier polygon of n points (stride `stride` apart, `H` coordinates) to [a, b].
-void restrict_line(double* P, int n, int stride, int H, double a, double b) {
-  auto at = [&](int i) { return P + static_cast<std::ptrdiff_t>(i) * stride; };
-  if (b < 1.0)  // left part [0, b]
-    for (int k = 1; k < n; ++k)
-      for (int i = n - 1; i >= k; --i)
-        for (int h = 0; h < H; ++h) at(i)[h] = (1.0 - b) * at(i - 1)[h] + b * at(i)[h];
-  const double t = b > 0.0 ? a / b : 0.0;
-  if (t > 0.0)  // right part [t, 1] of what is left
-    for (int k = 1; k < n; ++k)
-      for (int i = 0; i < n - k; ++i)
-        for (int h = 0; h < H; ++h) at(i)[h] = (1.0 - t) * at(i)[h] + t * at(i + 1)[h];
-}
-
-/// Restricts direction d of a net (H coordinates per point, u fastest, orders ord) to the local
-/// interval [a, b], in place: restrict_line on every line along d.
-void restrict_dir(double* q, const std::array<int, 3>& ord, int H, int d, double a, double b) {
-  const int ou = ord[0], ov = ord[1], ow = ord[2];
-  if (d == 0)
-    for (int c = 0; c < ow; ++c)
-      for (int j = 0; j < ov; ++j) restrict_line(q + (c * ov + j) * ou * H, ou, H, H, a, b);
-  else if (d == 1)
-    for (int c = 0; c < ow; ++c)
-      for (int i = 0; i < ou; ++i) restrict_line(q + (c * ov * ou + i) * H, ov, ou * H, H, a, b);
-  else
-    for (int j = 0; j < ov; ++j)
-      for (int i = 0; i < ou; ++i) restrict_line(q + (j * ou + i) * H, ow, ou * ov * H, H, a, b);
-}
-
 /// Both halves of a net split at the middle of direction d, from one de Casteljau triangle per
-/// line: the same values as restrict_line to [0, 1/2] and to [1/2, 1] (each step 0.5 x + 0.5 y,
-/// x the point of lower index), at half the work of the two restrictions.
+/// line: the same values as de Casteljau's restrictions to [0, 1/2] and to [1/2, 1] (each step
+/// 0.5 x + 0.5 y, x the point of lower index), at half the work of the two restrictions.
 /// @param P     the net: H coordinates per point, u fastest, orders ord
 /// @param L, R  the halves (as many values as P), written
 void split_half(const double* P, const std::array<int, 3>& ord, int H, int d, double* L, double* R) {
@@ -730,16 +701,6 @@ struct Once {
 }  // namespace
 
 struct Locator::Data {
-  static constexpr int local_div = 8;
-  /// A piece's local bounds: the piece cut into local_div^3 sub-boxes, and for each the bounds
-  /// over it and its neighbours (up to 3 x 3 x 3 sub-boxes), each computed on first use under
-  /// its flag (a thin job meets only a few sub-boxes of a piece). The sub-box's net is the
-  /// piece's restricted along u, then v, then w; the local_div u restrictions are kept.
-  struct Local {
-    std::vector<double> u_nets;     ///< the net restricted along u to each u interval
-    std::vector<StepBounds> bounds;  ///< per sub-box, u fastest
-    std::unique_ptr<Once[]> done;  ///< per sub-box: its bounds computed
-  };
   struct Piece {
     int cell = 0;
     std::array<int, 3> order{};
@@ -753,8 +714,6 @@ struct Locator::Data {
     /// under bounds_once (a job touches only some pieces; the values do not depend on which
     /// thread computes them).
     mutable StepBounds bounds;
-    /// Tighter bounds near a point (see Local): created on first use, under local_once.
-    mutable std::unique_ptr<Local> local;
   };
   struct Cell {
     std::array<std::vector<double>, 3> breaks;  ///< distinct knots inside the domain
@@ -788,8 +747,6 @@ struct Locator::Data {
   std::vector<Cell> cells;
   std::vector<Piece> pieces;
   std::unique_ptr<Once[]> bounds_once;  ///< one per piece: its bounds computed
-  std::unique_ptr<Once[]> local_once;   ///< one per piece: its local bounds created
-  bool use_local = true;                         ///< false: whole-piece bounds only (memory)
   std::vector<double> pool;  ///< every piece's net, control point after control point
   std::vector<LocatorLeaf> leaves;
   std::vector<Node> nodes;
@@ -1110,49 +1067,6 @@ StepBounds step_bounds_of(const double* net, const Data::Piece& pc) {
   return b;
 }
 
-/// The local bounds' intervals: k-th sub-box and its neighbours, in the piece's local [0, 1].
-double local_lo(int k) { return std::max(0.0, (k - 1) / double(Data::local_div)); }
-double local_hi(int k) { return std::min(1.0, (k + 2) / double(Data::local_div)); }
-
-/// A piece's local bounds before any is computed: its net restricted along u to each interval.
-/// @param all  the piece's net, nc coordinates per control point
-std::unique_ptr<Data::Local> make_local(const double* all, const Data::Piece& pc) {
-  constexpr int L = Data::local_div;
-  auto loc = std::make_unique<Data::Local>();
-  const std::size_t size = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
-  loc->u_nets.resize(L * size);
-  for (int a = 0; a < L; ++a) {
-    double* q = loc->u_nets.data() + a * size;
-    std::copy(all, all + size, q);
-    restrict_dir(q, pc.order, pc.nc, 0, local_lo(a), local_hi(a));
-  }
-  loc->bounds.resize(static_cast<std::size_t>(L * L * L));
-  loc->done = std::make_unique<Once[]>(static_cast<std::size_t>(L * L * L));
-  return loc;
-}
-
-/// The StepBounds of sub-box (a, b, c) of a piece and its neighbours: of the net restricted to
-/// them along u (kept in `loc`), then v, then w.
-StepBounds local_bounds(const Data::Local& loc, const Data::Piece& pc, int a, int b, int c) {
-  const std::size_t size = static_cast<std::size_t>(pc.order[0] * pc.order[1] * pc.order[2] * pc.nc);
-  const double* qu = loc.u_nets.data() + static_cast<std::size_t>(a) * size;
-  std::vector<double> q(qu, qu + size);
-  restrict_dir(q.data(), pc.order, pc.nc, 1, local_lo(b), local_hi(b));
-  restrict_dir(q.data(), pc.order, pc.nc, 2, local_lo(c), local_hi(c));
-  // The fields step_bounds_of reads (not a copy of pc: its lazy members may be being written).
-  Data::Piece sub;
-  sub.order = pc.order;
-  sub.nc = pc.nc;
-  const int idx[3] = {a, b, c};
-  for (std::size_t d = 0; d < 3; ++d) {
-    const double lo = local_lo(idx[d]), hi = local_hi(idx[d]);
-    sub.lo[d] = pc.lo[d] + lo * pc.len[d];
-    sub.len[d] = (hi - lo) * pc.len[d];
-    sub.inv_len[d] = 1.0 / sub.len[d];
-  }
-  return step_bounds_of(q.data(), sub);
-}
-
 /// A cell's Bezier pieces, before they are built.
 struct CellPieces {
   Data::Cell cell;
@@ -1368,13 +1282,6 @@ Locator::Locator(const vmodel::VModel& model, LocatorOptions opt) : model_(&mode
   for (const auto& l : leaves) D.leaves.insert(D.leaves.end(), l.begin(), l.end());
   build_bvh(D);
   D.bounds_once = std::make_unique<Once[]>(D.pieces.size());
-  D.local_once = std::make_unique<Once[]>(D.pieces.size());
-  // Local bounds cost local_div^3 StepBounds per piece (about 250 kB) and milliseconds to
-  // compute: for models of thousands of pieces (finely refined cells) the whole-piece bounds
-  // serve instead, a few more anchors against gigabytes and seconds.
-  constexpr double local_budget = 256.0 * 1024 * 1024;
-  D.use_local = static_cast<double>(D.pieces.size()) * Data::local_div * Data::local_div * Data::local_div *
-                    static_cast<double>(sizeof(StepBounds)) <= local_budget;
   // Booleans' trimming: one locator per condition, built recursively (their cells may be
   // trimmed too).
   D.trims.resize(static_cast<std::size_t>(nc));
@@ -1590,20 +1497,6 @@ const StepBounds& Locator::step_bounds(int piece) const noexcept {
   if (!pc.k.all_first) return pc.bounds;  // not valid
   data_->bounds_once[static_cast<std::size_t>(piece)]([&] { pc.bounds = step_bounds_of(data_->pool.data() + pc.net, pc); });
   return pc.bounds;
-}
-
-const StepBounds& Locator::step_bounds(int piece, const Vec3& t) const noexcept {
-  const auto& pc = data_->pieces[static_cast<std::size_t>(piece)];
-  if (!pc.k.all_first || !data_->use_local) return step_bounds(piece);
-  data_->local_once[static_cast<std::size_t>(piece)]([&] { pc.local = make_local(data_->pool.data() + pc.net, pc); });
-  double s[3];
-  Data::local(pc, t, s);
-  int idx[3];
-  for (int d = 0; d < 3; ++d) idx[d] = std::min(Data::local_div - 1, static_cast<int>(s[d] * Data::local_div));
-  const auto k = static_cast<std::size_t>(idx[0] + Data::local_div * (idx[1] + Data::local_div * idx[2]));
-  Data::Local& loc = *pc.local;
-  loc.done[k]([&] { loc.bounds[k] = local_bounds(loc, pc, idx[0], idx[1], idx[2]); });
-  return loc.bounds[k];
 }
 
 namespace {

@@ -310,6 +310,42 @@ TEST_CASE("sampler: overlapping cells, the first in file order wins") {
   }
 }
 
+TEST_CASE("sampler: without clearing void voxels' properties, the same cells and the same properties elsewhere") {
+  // SamplerOptions::zero_void_props = false (the print job): the band's void voxels keep what it
+  // held (here a marker), every other voxel is as with the clearing; in bands that are whole
+  // blocks (written in place) and not (through the sampler's scratch).
+  const auto m = model_of({curved_tricubic()}, {"r", "g", "b"});
+  const auto grid = grid_for(m, {0.17, 0.29, 0.31});
+  slice::SamplerOptions keep;
+  keep.zero_void_props = false;
+  const LayerSampler cleared(m, grid), kept(m, grid, keep);
+  const int ny = grid.count[1];
+  std::int64_t voids = 0, marked = 0, live = 0;
+  for (int k : {2, grid.count[2] / 2})
+    for (const auto& [row0, rows] : std::vector<std::pair<int, int>>{{0, ny}, {4, 8}, {3, 6}}) {
+      RowBand want, got;
+      cleared.sample(k, row0, rows, want);
+      got.props.assign(want.props.size(), 7.0f);  // the band's old contents
+      kept.sample(k, row0, rows, got);
+      REQUIRE(got.cell == want.cell);
+      for (std::size_t v = 0; v < want.cell.size(); ++v)
+        for (std::size_t h = 0; h < 3; ++h) {
+          const float w = want.props[3 * v + h], g = got.props[3 * v + h];
+          if (want.cell[v] < 0) {
+            voids += h == 0;
+            CHECK(w == 0.0f);
+            marked += g == 7.0f;
+          } else {
+            live += h == 0;
+            CHECK(g == w);
+          }
+        }
+    }
+  CHECK(live > 100);
+  CHECK(voids > 100);
+  CHECK(marked > 0);  // the clearing was skipped
+}
+
 TEST_CASE("sampler: a layer cut into bands gives the same result as in one piece") {
   const auto m = model_of({curved_tricubic(), quarter_annulus(5, 10, 4)}, {"r", "g", "b"});
   auto m2 = m;

@@ -40,8 +40,8 @@
 /// only where its conditions admit it. Points within the tolerance of a cell count as inside it.
 ///
 /// Cost: construction O(pieces * leaves per piece * order^3 * dim), parallel over pieces (TBB;
-/// the same locator for any thread count). A piece's StepBounds and local bounds are computed on
-/// first use (a job touches only some pieces, and some parts of them).
+/// the same locator for any thread count). A piece's StepBounds are computed on first use (a
+/// job touches only some pieces).
 /// A query: a BVH descent plus, per candidate leaf, a few Newton iterations of O(order^3)
 /// (geometry only; properties cost one more O(order^3 * m) evaluation at the answer). Orders up
 /// to 16; kernels specialised for orders 2, 3 and 4 in all directions.
@@ -272,10 +272,6 @@ public:
   /// The second-derivative bounds of a piece (Expansion::piece). Computed on first use
   /// (thread-safe; the values do not depend on the caller); the reference stays valid.
   const StepBounds& step_bounds(int piece) const noexcept;
-  /// Tighter bounds for certificates near t (in that piece): those of the part of the piece
-  /// around t (about 3/8 of it along each direction; StepBounds::lo/hi say which part).
-  /// Computed on first use, as step_bounds(piece).
-  const StepBounds& step_bounds(int piece, const Vec3& t) const noexcept;
 
   /// Implementation data (Bernstein nets, BVH); opaque.
   struct Data;

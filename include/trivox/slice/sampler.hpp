@@ -101,6 +101,7 @@ struct RowBand {
   int nprops = 0;  ///< properties per voxel (VModel::properties.size())
   std::vector<std::int32_t> cell;  ///< rows * nx: cell index into VModel::cells, or -1 (void)
   std::vector<float> props;        ///< rows * nx * nprops, voxel after voxel; 0 for void voxels
+                                   ///< (unspecified with SamplerOptions::zero_void_props false)
   /// Voxels whose inversion did not converge even after subdivision. Each takes its best guess:
   /// inside (at the best iterate) when that iterate's image lies within half the smallest pitch of
   /// the centre, else void. Reported in the job summary and manifest, never silent.
@@ -138,6 +139,10 @@ bool property_blend_from_name(std::string_view name, PropertyBlend& out) noexcep
 struct SamplerOptions {
   bool keep_uvw = false;  ///< also fill RowBand::uvw (tests, diagnostics)
   PropertyBlend blend = PropertyBlend::encoded;  ///< properties of Shepard fillet cells
+  /// Zero the properties of void voxels. A caller that never reads them (the print job: every
+  /// dithering mode looks at the cell first) sets false, and the sampler then leaves whatever
+  /// its band held there, saving the 4 m bytes per voxel of clearing each block.
+  bool zero_void_props = true;
 };
 
 class LayerSampler {
