@@ -17,6 +17,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "trivox/error.hpp"
 #include "trivox/geom/closest_point.hpp"
@@ -1032,6 +1033,63 @@ StepBounds second_derivative_bounds(const double* net, const Data::Piece& pc) {
   return b;
 }
 
+/// Bounds on the properties' third partials (coordinates 3 .. nc - 1 of a polynomial net), from
+/// the convex hull of their third differences: for c_d derivatives along each direction d
+/// (c_u + c_v + c_w = 3) the partial is a Bezier polynomial of degrees n_d - c_d whose
+/// coefficients are the mixed differences prod_d Delta_d^{c_d} of the control points times
+/// prod_d n_d! / (n_d - c_d)! / len_d^{c_d} (n_d = order_d - 1), so their largest magnitude
+/// bounds it (zero where some c_d exceeds n_d).
+void third_partial_bounds(const double* net, const Data::Piece& pc, StepBounds& b) {
+  const auto& o = pc.order;
+  const int nc = pc.nc;
+  const std::ptrdiff_t stride[3] = {nc, static_cast<std::ptrdiff_t>(o[0]) * nc, static_cast<std::ptrdiff_t>(o[0] * o[1]) * nc};
+  for (int d = 0; d < 3; ++d)
+    for (int e = d; e < 3; ++e)
+      for (int f = e; f < 3; ++f) {
+        int c[3] = {0, 0, 0};
+        ++c[d], ++c[e], ++c[f];
+        double factor = 1.0;
+        std::array<int, 3> lim = o;
+        for (std::size_t k = 0; k < 3; ++k) {
+          const int n = o[k] - 1;
+          for (int j = 0; j < c[k]; ++j) factor *= (n - j) * pc.inv_len[k];
+          lim[k] -= c[k];
+        }
+        double bp = 0.0;
+        if (factor != 0.0 && lim[0] > 0 && lim[1] > 0 && lim[2] > 0) {
+          // The offsets and signs of the mixed difference: prod_k sum_j (-1)^(c_k - j) C(c_k, j) at +j along k.
+          std::vector<std::pair<std::ptrdiff_t, double>> terms{{0, 1.0}};
+          for (std::size_t k = 0; k < 3; ++k)
+            for (int r = 0; r < c[k]; ++r) {  // one more first difference along k: x(+1) - x
+              std::vector<std::pair<std::ptrdiff_t, double>> next;
+              for (const auto& [off, w] : terms) {
+                next.push_back({off + stride[k], w});
+                next.push_back({off, -w});
+              }
+              terms = std::move(next);
+            }
+          for (int cw = 0; cw < lim[2]; ++cw)
+            for (int cv = 0; cv < lim[1]; ++cv)
+              for (int cu = 0; cu < lim[0]; ++cu) {
+                const double* p = net + cu * stride[0] + cv * stride[1] + cw * stride[2];
+                for (int h = 3; h < nc; ++h) {
+                  double v = 0.0;
+                  for (const auto& [off, w] : terms) v += w * p[off + h];
+                  bp = std::max(bp, std::abs(v));
+                }
+              }
+        }
+        const double bound = bp * std::abs(factor) * (1.0 + 1e-12);
+        const int idx[3] = {d, e, f};
+        // Every ordering of (d, e, f).
+        for (int x = 0; x < 3; ++x)
+          for (int y = 0; y < 3; ++y)
+            for (int z = 0; z < 3; ++z)
+              if (x != y && y != z && x != z)
+                b.p3[static_cast<std::size_t>(idx[x])][static_cast<std::size_t>(idx[y])][static_cast<std::size_t>(idx[z])] = bound;
+      }
+}
+
 /// Hodograph bound: |dX/dt_d| <= (order - 1) max |P_{i+1} - P_i| / len (polynomial nets with
 /// `stride` coordinates per point, xyz first).
 Vec3 hodograph_bounds(const double* net, const Data::Piece& pc, int stride) {
@@ -1062,6 +1120,7 @@ Vec3 hodograph_bounds(const double* net, const Data::Piece& pc, int stride) {
 /// the parameter box of `net`, nc = 3 + m coordinates per point).
 StepBounds step_bounds_of(const double* net, const Data::Piece& pc) {
   StepBounds b = second_derivative_bounds(net, pc);
+  third_partial_bounds(net, pc, b);
   b.slope = hodograph_bounds(net, pc, pc.nc);
   for (std::size_t d = 0; d < 3; ++d) b.degree[d] = pc.order[d] - 1;
   return b;

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -114,6 +115,7 @@ struct Anchor {
   int piece = -1;                     ///< the expansion's piece
   std::array<double, Expansion::max_props> pb{}, pdx{}, pdy{};  ///< P(k, l) likewise (step 0)
   int step = 0;                       ///< properties exact every step columns (0: P(k, l))
+  bool quad = false;                  ///< between the exact ones quadratic, not linear (fill)
 
   bool covers(int l, int i) const { return lo[static_cast<std::size_t>(l)] <= i && i <= hi[static_cast<std::size_t>(l)]; }
   /// Whether it certifies some voxels in each of the block's `rows` rows.
@@ -208,6 +210,7 @@ public:
       for (std::size_t d = 0; d < 3; ++d) gmax_[d] = std::max(gmax_[d], std::abs(e.grad[h][d]));
     a.piece = e.piece;
     a.step = 0;
+    a.quad = false;
     for (std::size_t j = 0; j < 3; ++j) {
       // box_cap's terms: the room between t0 + c0 and the box grown by tol / slope.
       const double base = e.t[j] + c0_[j];
@@ -259,7 +262,7 @@ public:
         a.lo[static_cast<std::size_t>(r)] = std::max(0, i - shift);
         a.hi[static_cast<std::size_t>(r)] = std::min(nx_ - 1, i + K);
       }
-      a.step = sample_step(err_);
+      a.step = sample_step(err_, a.quad);
       return true;
     }
     // The whole block first; the narrower shapes only when it spans few columns.
@@ -299,7 +302,7 @@ public:
       }
       best_err = worst;
     }
-    a.step = sample_step(best_err);
+    a.step = sample_step(best_err, a.quad);
     return true;
   }
 
@@ -312,20 +315,36 @@ private:
 
   /// How a certified rectangle with errors `err` gets its properties (Anchor's comment): 0, the
   /// first-order model, when its remainder fits the budget too (no evaluations); else the spacing
-  /// of exact evaluations along its rows, the largest s with s^2 / 8 Q2 within the budget the
-  /// gradient term leaves, Q2 bounding |d^2 P / dk^2| = |dx^T (d^2 P / dt^2) dx| by the part's
-  /// second-partial bounds (times the 1.01 of a certificate reaching out of the part).
-  int sample_step(const Errors& err) const {
+  /// s of exact evaluations along its rows, with the interpolation's error within the budget the
+  /// gradient term leaves, `room`. Along a row the properties are the polynomial f(k) = P(t0 +
+  /// k dx): linear interpolation between samples s apart errs by at most s^2 / 8 Q2, Q2 >= |f''|
+  /// = |dx^T (d^2 P / dt^2) dx| from the piece's second-partial bounds; quadratic interpolation
+  /// through three samples at most s apart (fill) by |f'''| / 6 max |(k - a)(k - b)(k - c)| <=
+  /// Q3 / 6 * s^3 / 2 (on [a, b]: (k - a)(b - k) <= s^2 / 4 and c - k <= 2 s; on [b, c] alike),
+  /// Q3 >= |f'''| = |sum d^3 P / dt_d dt_e dt_f dx_d dx_e dx_f| from the third-partial bounds.
+  /// Both bounds times the 1.01 of a certificate reaching out of the piece. Quadratic where it
+  /// spaces the samples farther (stepped by forward differences, it costs one add per value more
+  /// than linear: less than the exact samples it saves).
+  int sample_step(const Errors& err, bool& quad) const {
+    quad = false;
     if (m_ == 0 || err.grad + err.taylor <= prop_budget) return 0;
     const double grad = err.grad;
     const auto& P = b_->p2;
-    double q2 = 0.0;
+    const auto& P3 = b_->p3;
+    double q2 = 0.0, q3 = 0.0;
     for (std::size_t d = 0; d < 3; ++d)
-      for (std::size_t f = 0; f < 3; ++f) q2 += std::abs(dx_[d]) * std::abs(dx_[f]) * P[d][f];
+      for (std::size_t f = 0; f < 3; ++f) {
+        q2 += std::abs(dx_[d]) * std::abs(dx_[f]) * P[d][f];
+        for (std::size_t g = 0; g < 3; ++g) q3 += std::abs(dx_[d]) * std::abs(dx_[f]) * std::abs(dx_[g]) * P3[d][f][g];
+      }
     q2 *= 1.01;
+    q3 *= 1.01;
     const double room = prop_budget - grad;
-    const double s = q2 > 0.0 ? std::floor(std::sqrt(8.0 * room / q2)) : static_cast<double>(nx_);
-    return static_cast<int>(std::clamp(s, 1.0, static_cast<double>(std::max(nx_, 1))));
+    const double most = static_cast<double>(std::max(nx_, 1));
+    const double s = q2 > 0.0 ? std::floor(std::sqrt(8.0 * room / q2)) : most;
+    const double s3 = q3 > 0.0 ? std::floor(std::cbrt(12.0 * room / q3)) : most;
+    quad = s3 >= 2.0 && s3 > s;
+    return static_cast<int>(std::clamp(quad ? s3 : s, 1.0, most));
   }
 
   /// The largest k for which the rectangle of columns -kn .. k (kn < 0: -k .. k) and rows -ln ..
@@ -673,8 +692,13 @@ Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, 
   return Outcome::inside;
 }
 
+/// Four doubles and four floats as vectors (GCC and Clang vector extensions; the same IEEE
+/// operations lane by lane on any target).
+using V4d = double __attribute__((vector_size(32)));
+using V4f = float __attribute__((vector_size(16)));
+
 /// out[j m + h] = va[h] + j slope[h] for j < n, h < m (a run of voxels' properties from a linear
-/// model): four voxels' m values at a time, as one flat run of 4m floats (base + block * delta),
+/// model): four voxels' m values at a time, as one flat run of 4m floats (base, stepped by delta per block),
 /// which vectorises. M: m known at compile time (-1: m).
 template <int M>
 [[gnu::always_inline]] inline void write_linear_body(float* out, int n, int m, const double* va, const double* slope) {
@@ -692,13 +716,30 @@ template <int M>
       base[v * um + h] = va[h] + v * slope[h];
       delta[v * um + h] = 4.0 * slope[h];
     }
+  // Block by block, the values stepped by one add each (the rounding this accumulates over a
+  // run of a few hundred voxels is some 1e-14 of the values, far below the floats written).
   const int blocks = n / 4;
   float* o = out;
-  double fb = 0.0;  // the block index, counted in doubles (exact), not converted per block
-  for (int b = 0; b < blocks; ++b, o += w, fb += 1.0)
-    for (int k = 0; k < w; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
+  if constexpr (M > 0) {  // the 4 M values as M vectors of four, kept in registers
+    V4d bv[M], dv[M];
+    std::memcpy(bv, base, sizeof bv);
+    std::memcpy(dv, delta, sizeof dv);
+    for (int b = 0; b < blocks; ++b, o += w)
+      for (int i = 0; i < M; ++i) {
+        const V4f f = __builtin_convertvector(bv[i], V4f);
+        std::memcpy(o + 4 * i, &f, sizeof f);
+        bv[i] += dv[i];
+      }
+    std::memcpy(base, bv, sizeof bv);
+  } else {
+    for (int b = 0; b < blocks; ++b, o += w)
+      for (int k = 0; k < w; ++k) {
+        o[k] = static_cast<float>(base[k]);
+        base[k] += delta[k];
+      }
+  }
   const int rest = (n - 4 * blocks) * um;
-  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k] + fb * delta[k]);
+  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k]);
 }
 
 template <int M>
@@ -714,6 +755,84 @@ template <int M>
 #endif
 
 using WriteLinear = void (*)(float*, int, int, const double*, const double*);
+
+/// out[j m + h] = va[h] + j (slope[h] + j curv[h]) for j < n, h < m (a run of voxels' properties
+/// from a quadratic): four voxels at a time as one flat run of 4m values, voxel 4 b + v being
+/// g(b) = (va + v slope + v^2 curv) + b (4 slope + 8 v curv) + b^2 (16 curv), stepped from block
+/// to block by forward differences (g(b + 1) - g(b) = 4 slope + 8 v curv + (2 b + 1) 16 curv).
+/// M as write_linear_body's.
+template <int M>
+[[gnu::always_inline]] inline void write_quadratic_body(float* out, int n, int m, const double* va, const double* slope,
+                                                        const double* curv) {
+  const int um = M >= 0 ? M : m;
+  constexpr int W = 4 * (M >= 0 ? M : Expansion::max_props);
+  double base[W > 0 ? W : 1], step[W > 0 ? W : 1], step2[W > 0 ? W : 1];
+  const int w = 4 * um;
+  for (int h = 0; h < um; ++h)
+    for (int v = 0; v < 4; ++v) {
+      base[v * um + h] = va[h] + v * (slope[h] + v * curv[h]);
+      step[v * um + h] = 4.0 * slope[h] + 8.0 * v * curv[h] + 16.0 * curv[h];
+      step2[v * um + h] = 32.0 * curv[h];
+    }
+  const int blocks = n / 4;
+  float* o = out;
+  if constexpr (M > 0) {  // as write_linear_body: M vectors of four each, in registers
+    V4d bv[M], sv[M], s2[M];
+    std::memcpy(bv, base, sizeof bv);
+    std::memcpy(sv, step, sizeof sv);
+    std::memcpy(s2, step2, sizeof s2);
+    for (int b = 0; b < blocks; ++b, o += w)
+      for (int i = 0; i < M; ++i) {
+        const V4f f = __builtin_convertvector(bv[i], V4f);
+        std::memcpy(o + 4 * i, &f, sizeof f);
+        bv[i] += sv[i];
+        sv[i] += s2[i];
+      }
+    std::memcpy(base, bv, sizeof bv);
+  } else {
+    for (int b = 0; b < blocks; ++b, o += w)
+      for (int k = 0; k < w; ++k) {
+        o[k] = static_cast<float>(base[k]);
+        base[k] += step[k];
+        step[k] += step2[k];
+      }
+  }
+  const int rest = (n - 4 * blocks) * um;
+  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k]);
+}
+
+template <int M>
+void write_quadratic(float* out, int n, int m, const double* va, const double* slope, const double* curv) {
+  write_quadratic_body<M>(out, n, m, va, slope, curv);
+}
+#if defined(__x86_64__)
+template <int M>
+[[gnu::target("avx2")]] void write_quadratic_avx2(float* out, int n, int m, const double* va, const double* slope,
+                                                  const double* curv) {
+  write_quadratic_body<M>(out, n, m, va, slope, curv);
+}
+#endif
+
+using WriteQuadratic = void (*)(float*, int, int, const double*, const double*, const double*);
+
+template <int M>
+WriteQuadratic write_quadratic_for() {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) return write_quadratic_avx2<M>;
+#endif
+  return write_quadratic<M>;
+}
+
+WriteQuadratic pick_write_quadratic(int m) {
+  switch (m) {
+    case 1: return write_quadratic_for<1>();
+    case 2: return write_quadratic_for<2>();
+    case 3: return write_quadratic_for<3>();
+    case 4: return write_quadratic_for<4>();
+    default: return write_quadratic_for<-1>();
+  }
+}
 
 template <int M>
 WriteLinear write_for() {
@@ -748,7 +867,8 @@ struct BlockOut {
 class BlockSampler {
 public:
   BlockSampler(const Locator& loc, const VoxelGrid& grid)
-      : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())), write_(pick_write(m_)) {}
+      : loc_(loc), grid_(grid), m_(static_cast<int>(loc.model().properties.size())), write_(pick_write(m_)),
+        write_quad_(pick_write_quadratic(m_)) {}
 
   void run(int layer, int r0, int nr, BlockOut& out) {
     const int nx = grid_.count[0], ny = grid_.count[1];
@@ -921,6 +1041,10 @@ private:
       return;
     }
     const int step = a.step;
+    if (a.quad) {
+      fill_quadratic(a, l, i0, n, out);
+      return;
+    }
     const int count = n == 1 ? 1 : (n - 2) / step + 2;  // samples at 0, step, 2 step, ..., n - 1
     pts_.resize(static_cast<std::size_t>(count));
     vals_.resize(static_cast<std::size_t>(count) * um);
@@ -937,6 +1061,56 @@ private:
       write_(out + static_cast<std::size_t>(ja) * um, jb - ja, m_, va, slope);
     }
     const double* vl = vals_.data() + static_cast<std::size_t>(count - 1) * um;
+    for (std::size_t h = 0; h < um; ++h) out[static_cast<std::size_t>(n - 1) * um + h] = static_cast<float>(vl[h]);
+  }
+
+  /// fill's quadratic form (Anchor::quad): the n voxels from i0 in segments of at most 2 step
+  /// voxels, each with exact samples at its ends and at its middle (so both halves are at most
+  /// step long, as sample_step's bound needs), the quadratic through the three in between; a
+  /// segment of one voxel takes its two ends alone. The last voxel is its exact sample.
+  void fill_quadratic(const Anchor& a, int l, int i0, int n, float* out) {
+    const auto um = static_cast<std::size_t>(m_);
+    const int step = a.step;
+    // Sample offsets: 0, then per segment its middle (when it has one) and its end.
+    offs_.clear();
+    offs_.push_back(0);
+    for (int start = 0; start < n - 1;) {
+      const int len = std::min(2 * step, n - 1 - start);
+      if (len >= 2) offs_.push_back(start + len / 2);
+      offs_.push_back(start + len);
+      start += len;
+    }
+    const auto count = offs_.size();
+    pts_.resize(count);
+    vals_.resize(count * um);
+    for (std::size_t q = 0; q < count; ++q) pts_[q] = a.at(l, i0 + offs_[q]);
+    loc_.piece_properties(a.piece, pts_.data(), static_cast<int>(count), vals_.data());
+    for (std::size_t q = 0; q + 1 < count;) {
+      const int ja = offs_[q], jb = offs_[q + 1];
+      const double* va = vals_.data() + q * um;
+      const bool three = q + 2 < count && offs_[q + 2] - ja <= 2 * step && jb - ja == (offs_[q + 2] - ja) / 2;
+      double slope[Expansion::max_props], curv[Expansion::max_props];
+      if (three) {
+        // Newton's form through (0, f0), (h1, f1), (h1 + h2, f2): f0 + x d1 + x (x - h1) d2.
+        const int jc = offs_[q + 2];
+        const double h1 = jb - ja, h2 = jc - jb;
+        const double* vb = va + um;
+        const double* vc = vb + um;
+        for (std::size_t h = 0; h < um; ++h) {
+          const double d1 = (vb[h] - va[h]) / h1, d2 = ((vc[h] - vb[h]) / h2 - d1) / (h1 + h2);
+          slope[h] = d1 - h1 * d2;
+          curv[h] = d2;
+        }
+        write_quad_(out + static_cast<std::size_t>(ja) * um, jc - ja, m_, va, slope, curv);
+        q += 2;
+      } else {
+        const double* vb = va + um;
+        for (std::size_t h = 0; h < um; ++h) slope[h] = (vb[h] - va[h]) / (jb - ja);
+        write_(out + static_cast<std::size_t>(ja) * um, jb - ja, m_, va, slope);
+        q += 1;
+      }
+    }
+    const double* vl = vals_.data() + (count - 1) * um;
     for (std::size_t h = 0; h < um; ++h) out[static_cast<std::size_t>(n - 1) * um + h] = static_cast<float>(vl[h]);
   }
 
@@ -1081,6 +1255,7 @@ private:
   const VoxelGrid& grid_;
   int m_;
   WriteLinear write_;
+  WriteQuadratic write_quad_;
   BlockOut* out_ = nullptr;
   double tol_ = 0.0, z_ = 0.0;
   int nr_ = 0;  ///< the block's rows
@@ -1095,6 +1270,7 @@ private:
   AnchorMaker* maker_ = nullptr;
   Expansion exp_;
   std::vector<Vec3> pts_;      ///< fill's sample points
+  std::vector<int> offs_;      ///< fill_quadratic's sample offsets in the run
   std::vector<double> vals_;   ///< and their properties
 };
 

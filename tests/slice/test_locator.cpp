@@ -162,7 +162,7 @@ TEST_CASE("locate: bad options and cells are reported") {
   CHECK(b[1] == Vec3{4, 7, 6});
 }
 
-TEST_CASE("locate: expansions equal the spline's first partials, and step bounds bound the second") {
+TEST_CASE("locate: expansions equal the spline's first partials, and step bounds bound the second and third") {
   // Two pieces per direction (an interior knot), so bounds are per piece and in global parameters.
   auto cell = curved_tricubic();
   for (int d = 0; d < 3; ++d) cell = spline::refine_uniform(cell, d, 1);
@@ -198,6 +198,53 @@ TEST_CASE("locate: expansions equal the spline's first partials, and step bounds
       CHECK(std::hypot(v[0], v[1], v[2]) <= b.b2[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] * (1 + 1e-9));
       for (int h = 3; h < 6; ++h) CHECK(std::abs(v[h]) <= b.p2[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] * (1 + 1e-9));
     }
+    // The third partials of the properties, by central differences of the second (h = 1e-5,
+    // away from the pieces' joins at 0.5, where they jump): d/dt_k of d^2 P / dt_i dt_j.
+    bool near_join = false;
+    for (std::size_t k = 0; k < 3; ++k) near_join = near_join || std::abs(t[k] - 0.5) < 1e-3;
+    if (!near_join) {
+      const double h = 1e-5;
+      for (std::size_t k = 0; k < 3; ++k) {
+        Vec3 tp = t, tm = t;
+        tp[k] += h;
+        tm[k] -= h;
+        const auto dp = cell.eval_derivatives(tp, 2), dm = cell.eval_derivatives(tm, 2);
+        for (std::size_t s = 4; s < 10; ++s) {
+          const auto& a = slots[s];
+          std::array<std::size_t, 3> ix{0, 0, k};
+          std::size_t n2 = 0;
+          for (std::size_t q = 0; q < 3; ++q)
+            for (int c = 0; c < a[q]; ++c) ix[n2++] = q;
+          for (std::size_t c = 3; c < 6; ++c) {
+            const double third = (dp[6 * s + c] - dm[6 * s + c]) / (2 * h);
+            const double bound = b.p3[ix[0]][ix[1]][ix[2]];
+            CHECK(std::abs(third) <= bound * (1 + 1e-5) + 1e-6);
+            CHECK(bound == b.p3[ix[2]][ix[0]][ix[1]]);  // symmetric
+            CHECK(bound == b.p3[ix[1]][ix[2]][ix[0]]);
+          }
+        }
+      }
+    }
+  }
+  // Tight where the property is one monomial: a unit cube whose property is u^3 v, with Bezier
+  // coefficients [i = 3] j / 3 (u^3 = B_3,3(u), v = sum_j (j/3) B_j,3(v)): d^3/du^3 = 6 v and
+  // d^3/du^2 dv = 6 u reach 6, d^3/dv^3, d^3/du dv^2 and d^3/dw^3 are 0.
+  {
+    std::vector<double> pts;  // u fastest; x = u, y = v, z = w (linear precision)
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) pts.insert(pts.end(), {i / 3.0, j / 3.0, k / 3.0, i == 3 ? j / 3.0 : 0.0});
+    const auto cubic = KnotVector::bezier(4);
+    const auto mono = model_of({Trivariate({cubic, cubic, cubic}, 4, pts)}, {"r"});
+    const slice::Locator lm(mono);
+    slice::Expansion e;
+    REQUIRE(lm.expand(0, {0.5, 0.5, 0.5}, e));
+    const auto& b = lm.step_bounds(e.piece);
+    CHECK(b.p3[0][0][0] == Approx(6.0).epsilon(1e-9));
+    CHECK(b.p3[0][0][1] == Approx(6.0).epsilon(1e-9));
+    CHECK(b.p3[1][1][1] == Approx(0.0).margin(1e-12));  // up to rounding in the differences
+    CHECK(b.p3[0][1][1] == Approx(0.0).margin(1e-12));
+    CHECK(b.p3[2][2][2] == Approx(0.0).margin(1e-12));
   }
   // Rational pieces have no expansion (their cells take the exact path).
   const auto q = model_of({quarter_annulus(5, 10, 4)}, {"v"});

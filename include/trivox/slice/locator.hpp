@@ -172,6 +172,8 @@ struct StepBounds {
   double lip = 0.0;    ///< max_d sqrt(sum_e b2[d][e]^2): |J(a) - J(b)|_F <= lip |a - b|_1
   /// p2[d][e] >= |d^2 P_h / dt_d dt_e| for every property h
   std::array<Vec3, 3> p2{};
+  /// p3[d][e][f] >= |d^3 P_h / dt_d dt_e dt_f| for every property h (symmetric)
+  std::array<std::array<Vec3, 3>, 3> p3{};
   Vec3 slope{};                   ///< slope[d] >= |dX / dt_d| (xyz, Euclidean norm) in the piece
   std::array<int, 3> degree{};    ///< polynomial degree per direction
 };

@@ -25,9 +25,11 @@
 ///   properties' error below 0.95/512. The properties come from the first-order model
 ///   P0 + G0 (t - t0) where its Taylor remainder fits that budget; else from the piece's own
 ///   polynomial, evaluated exactly at the t of every s-th voxel of a row (Locator::
-///   piece_properties) and interpolated linearly in between, the error being the gradient times
-///   |t* - t| (at most half the budget) plus s^2 / 8 times a bound on the second derivative
-///   along the row (the rest). So where the cells are nearly affine at voxel scale and the
+///   piece_properties) and interpolated in between, the error being the gradient times
+///   |t* - t| (at most half the budget) plus the interpolation's (the rest): linearly, s^2 / 8
+///   times a bound on the second derivative along the row, or, where that spaces the samples
+///   farther, quadratically through three samples at most s apart, s^3 / 12 times a
+///   bound on the third derivative (StepBounds::p3). So where the cells are nearly affine at voxel scale and the
 ///   properties vary fast (the twisted column of models/: radii r about 1e-10), an anchor is
 ///   limited by the piece and the cell's shape, not by its properties: hundreds of voxels
 ///   instead of tens. All bounds
