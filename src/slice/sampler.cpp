@@ -177,9 +177,9 @@ public:
     // curvature term J0^-1 d^2X/du^2 hundreds of units of w per unit of u, so that theta passed
     // 1/2 within a few voxels although the linear model stayed exact to 1e-5 of the pitch.
     // In s: G_s = D G, G_s' = D G' D^-1, so w[d][e] bounds |D J0^-1 d^2X/dt_d dt_e| / (D_d D_e).
-    // Both norms are kept (Norm): the scaled one certifies rectangles inside the part, the
+    // Both norms are kept (Norm): the scaled one certifies rectangles inside the piece, the
     // plain one is tried where that fails (an isotropic cell may do better unscaled) and alone
-    // certifies rectangles reaching out of the part (the layer-thin cells' faces).
+    // certifies rectangles reaching out of the piece (the layer-thin cells' faces).
     Vec3 len{};
     for (std::size_t d = 0; d < 3; ++d) {
       const Vec3& c = e.jac[d];
@@ -350,7 +350,7 @@ private:
   /// The largest k for which the rectangle of columns -kn .. k (kn < 0: -k .. k) and rows -ln ..
   /// lp keeps its linear-model parameters inside the bounds' box grown by the certificate's
   /// reach out of it (tol / slope per direction; at most nx, at least 0): no larger k is
-  /// certified, and where the box binds (a cell's face, the part's edge) it is the anchor's
+  /// certified, and where the box binds (a cell's face, the piece's edge) it is the anchor's
   /// width, found without a search (room_lo_, room_hi_, inv_dx_ from make()).
   int box_cap(int kn, int ln, int lp) const {
     double cap = nx_;
@@ -482,7 +482,7 @@ private:
       off += b_->slope[j] * out[j];
     }
     if (off > 0.0) {
-      if (scaled) return 0;  // out of the part: the plain norm's proof alone
+      if (scaled) return 0;  // out of the piece: the plain norm's proof alone
       // grow >= 1: too far out whatever the growth factor (and a larger G only reaches farther).
       if (!(off <= tol_)) return 0;
       double grow = 1.0;
