@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cstring>
+#include <type_traits>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -697,6 +698,38 @@ Outcome solve_voxel(const Locator& loc, const VoxelGrid& grid, int cell, int i, 
 using V4d = double __attribute__((vector_size(32)));
 using V4f = float __attribute__((vector_size(16)));
 
+/// The blocks of a run (write_linear_body, write_quadratic_body): `blocks` blocks of w = 4 M
+/// values from base, stepped by one add each per block (by step, and step by step2 when Q);
+/// then the values after the last block, of the rest of the run (`rest` of them). The rounding
+/// this accumulates over a run of a few hundred voxels is some 1e-14 of the values, far below
+/// the floats written. With M known, the values are M vectors of four, kept in registers.
+template <int M, bool Q>
+[[gnu::always_inline]] inline void step_blocks(float* o, int blocks, int w, int rest, double* base, double* step,
+                                               const double* step2) {
+  if constexpr (M > 0) {
+    V4d bv[M], sv[M], s2[M];
+    std::memcpy(bv, base, sizeof bv);
+    std::memcpy(sv, step, sizeof sv);
+    if constexpr (Q) std::memcpy(s2, step2, sizeof s2);
+    for (int b = 0; b < blocks; ++b, o += w)
+      for (int i = 0; i < M; ++i) {
+        const V4f f = __builtin_convertvector(bv[i], V4f);
+        std::memcpy(o + 4 * i, &f, sizeof f);
+        bv[i] += sv[i];
+        if constexpr (Q) sv[i] += s2[i];
+      }
+    std::memcpy(base, bv, sizeof bv);
+  } else {
+    for (int b = 0; b < blocks; ++b, o += w)
+      for (int k = 0; k < w; ++k) {
+        o[k] = static_cast<float>(base[k]);
+        base[k] += step[k];
+        if constexpr (Q) step[k] += step2[k];
+      }
+  }
+  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k]);
+}
+
 /// out[j m + h] = va[h] + j slope[h] for j < n, h < m (a run of voxels' properties from a linear
 /// model): four voxels' m values at a time, as one flat run of 4m floats (base, stepped by delta per block),
 /// which vectorises. M: m known at compile time (-1: m).
@@ -716,30 +749,8 @@ template <int M>
       base[v * um + h] = va[h] + v * slope[h];
       delta[v * um + h] = 4.0 * slope[h];
     }
-  // Block by block, the values stepped by one add each (the rounding this accumulates over a
-  // run of a few hundred voxels is some 1e-14 of the values, far below the floats written).
   const int blocks = n / 4;
-  float* o = out;
-  if constexpr (M > 0) {  // the 4 M values as M vectors of four, kept in registers
-    V4d bv[M], dv[M];
-    std::memcpy(bv, base, sizeof bv);
-    std::memcpy(dv, delta, sizeof dv);
-    for (int b = 0; b < blocks; ++b, o += w)
-      for (int i = 0; i < M; ++i) {
-        const V4f f = __builtin_convertvector(bv[i], V4f);
-        std::memcpy(o + 4 * i, &f, sizeof f);
-        bv[i] += dv[i];
-      }
-    std::memcpy(base, bv, sizeof bv);
-  } else {
-    for (int b = 0; b < blocks; ++b, o += w)
-      for (int k = 0; k < w; ++k) {
-        o[k] = static_cast<float>(base[k]);
-        base[k] += delta[k];
-      }
-  }
-  const int rest = (n - 4 * blocks) * um;
-  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k]);
+  step_blocks<M, false>(out, blocks, w, (n - 4 * blocks) * um, base, delta, nullptr);
 }
 
 template <int M>
@@ -775,30 +786,7 @@ template <int M>
       step2[v * um + h] = 32.0 * curv[h];
     }
   const int blocks = n / 4;
-  float* o = out;
-  if constexpr (M > 0) {  // as write_linear_body: M vectors of four each, in registers
-    V4d bv[M], sv[M], s2[M];
-    std::memcpy(bv, base, sizeof bv);
-    std::memcpy(sv, step, sizeof sv);
-    std::memcpy(s2, step2, sizeof s2);
-    for (int b = 0; b < blocks; ++b, o += w)
-      for (int i = 0; i < M; ++i) {
-        const V4f f = __builtin_convertvector(bv[i], V4f);
-        std::memcpy(o + 4 * i, &f, sizeof f);
-        bv[i] += sv[i];
-        sv[i] += s2[i];
-      }
-    std::memcpy(base, bv, sizeof bv);
-  } else {
-    for (int b = 0; b < blocks; ++b, o += w)
-      for (int k = 0; k < w; ++k) {
-        o[k] = static_cast<float>(base[k]);
-        base[k] += step[k];
-        step[k] += step2[k];
-      }
-  }
-  const int rest = (n - 4 * blocks) * um;
-  for (int k = 0; k < rest; ++k) o[k] = static_cast<float>(base[k]);
+  step_blocks<M, true>(out, blocks, w, (n - 4 * blocks) * um, base, step, step2);
 }
 
 template <int M>
@@ -815,42 +803,45 @@ template <int M>
 
 using WriteQuadratic = void (*)(float*, int, int, const double*, const double*, const double*);
 
-template <int M>
-WriteQuadratic write_quadratic_for() {
+/// Whether the CPU runs the AVX2 builds of the kernels.
+bool cpu_has_avx2() {
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2) return write_quadratic_avx2<M>;
+  return avx2;
+#else
+  return false;
 #endif
-  return write_quadratic<M>;
 }
 
-WriteQuadratic pick_write_quadratic(int m) {
+/// get(std::integral_constant<int, M>) for the property count m: M = m up to 4, else -1 (the
+/// kernels' run-time count).
+template <class Get>
+auto by_props(int m, Get get) {
   switch (m) {
-    case 1: return write_quadratic_for<1>();
-    case 2: return write_quadratic_for<2>();
-    case 3: return write_quadratic_for<3>();
-    case 4: return write_quadratic_for<4>();
-    default: return write_quadratic_for<-1>();
+    case 1: return get(std::integral_constant<int, 1>{});
+    case 2: return get(std::integral_constant<int, 2>{});
+    case 3: return get(std::integral_constant<int, 3>{});
+    case 4: return get(std::integral_constant<int, 4>{});
+    default: return get(std::integral_constant<int, -1>{});
   }
-}
-
-template <int M>
-WriteLinear write_for() {
-#if defined(__x86_64__)
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2) return write_linear_avx2<M>;
-#endif
-  return write_linear<M>;
 }
 
 WriteLinear pick_write(int m) {
-  switch (m) {
-    case 1: return write_for<1>();
-    case 2: return write_for<2>();
-    case 3: return write_for<3>();
-    case 4: return write_for<4>();
-    default: return write_for<-1>();
-  }
+  return by_props(m, [](auto k) -> WriteLinear {
+#if defined(__x86_64__)
+    if (cpu_has_avx2()) return write_linear_avx2<decltype(k)::value>;
+#endif
+    return write_linear<decltype(k)::value>;
+  });
+}
+
+WriteQuadratic pick_write_quadratic(int m) {
+  return by_props(m, [](auto k) -> WriteQuadratic {
+#if defined(__x86_64__)
+    if (cpu_has_avx2()) return write_quadratic_avx2<decltype(k)::value>;
+#endif
+    return write_quadratic<decltype(k)::value>;
+  });
 }
 
 /// Where a block's results go: rows of nx voxels, straight into the caller's band when the block
