@@ -1062,42 +1062,41 @@ private:
   void fill_quadratic(const Anchor& a, int l, int i0, int n, float* out) {
     const auto um = static_cast<std::size_t>(m_);
     const int step = a.step;
+    // The segments from `start`: len voxels, a middle sample where len >= 2.
+    auto seg_len = [&](int start) { return std::min(2 * step, n - 1 - start); };
     // Sample offsets: 0, then per segment its middle (when it has one) and its end.
     offs_.clear();
     offs_.push_back(0);
-    for (int start = 0; start < n - 1;) {
-      const int len = std::min(2 * step, n - 1 - start);
+    for (int start = 0; start < n - 1; start += seg_len(start)) {
+      const int len = seg_len(start);
       if (len >= 2) offs_.push_back(start + len / 2);
       offs_.push_back(start + len);
-      start += len;
     }
     const auto count = offs_.size();
     pts_.resize(count);
     vals_.resize(count * um);
     for (std::size_t q = 0; q < count; ++q) pts_[q] = a.at(l, i0 + offs_[q]);
     loc_.piece_properties(a.piece, pts_.data(), static_cast<int>(count), vals_.data());
-    for (std::size_t q = 0; q + 1 < count;) {
-      const int ja = offs_[q], jb = offs_[q + 1];
+    std::size_t q = 0;  // the segment's first sample
+    for (int start = 0; start < n - 1; start += seg_len(start)) {
+      const int len = seg_len(start);
       const double* va = vals_.data() + q * um;
-      const bool three = q + 2 < count && offs_[q + 2] - ja <= 2 * step && jb - ja == (offs_[q + 2] - ja) / 2;
+      const double* vb = va + um;
       double slope[Expansion::max_props], curv[Expansion::max_props];
-      if (three) {
+      if (len >= 2) {
         // Newton's form through (0, f0), (h1, f1), (h1 + h2, f2): f0 + x d1 + x (x - h1) d2.
-        const int jc = offs_[q + 2];
-        const double h1 = jb - ja, h2 = jc - jb;
-        const double* vb = va + um;
+        const double h1 = len / 2, h2 = len - len / 2;
         const double* vc = vb + um;
         for (std::size_t h = 0; h < um; ++h) {
           const double d1 = (vb[h] - va[h]) / h1, d2 = ((vc[h] - vb[h]) / h2 - d1) / (h1 + h2);
           slope[h] = d1 - h1 * d2;
           curv[h] = d2;
         }
-        write_quad_(out + static_cast<std::size_t>(ja) * um, jc - ja, m_, va, slope, curv);
+        write_quad_(out + static_cast<std::size_t>(start) * um, len, m_, va, slope, curv);
         q += 2;
-      } else {
-        const double* vb = va + um;
-        for (std::size_t h = 0; h < um; ++h) slope[h] = (vb[h] - va[h]) / (jb - ja);
-        write_(out + static_cast<std::size_t>(ja) * um, jb - ja, m_, va, slope);
+      } else {  // one voxel: its sample
+        for (std::size_t h = 0; h < um; ++h) slope[h] = vb[h] - va[h];
+        write_(out + static_cast<std::size_t>(start) * um, len, m_, va, slope);
         q += 1;
       }
     }
