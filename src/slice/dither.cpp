@@ -1153,8 +1153,8 @@ void LayerGroupDitherer::clear_errors() {
   for (auto& r : written_) r = {0, -1};
 }
 
-bool LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
-                              std::int64_t* const* counts) {
+void LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
+                              std::int64_t* const* counts, int& lo, int& hi) {
   if (layers_ < 1) throw Error("dithering: a row before begin()", ErrorKind::failed);
   if (row < 0 || row < next_row_)
     throw Error("dithering: row " + std::to_string(row) + " after rows up to " + std::to_string(next_row_ - 1) +
@@ -1164,9 +1164,8 @@ bool LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const fl
   next_row_ = row + 1;
   // The columns where some layer has a live voxel, [lo, hi]: outside them the kernel would only
   // write void and pass no error (a void column drops what is aimed at it), so it visits these.
-  int lo = nx_, hi = -1;
+  lo = nx_, hi = -1;
   for (int l = 0; l < layers_; ++l) widen_live_span(cell[l], nx_, lo, hi);
-  lo_ = lo, hi_ = hi;
   // The error for the next row: the kernel writes columns lo - 1 .. hi + 1 (pads included), and
   // the rest of that half must read as zero, as the whole-row kernel leaves it. Each half is
   // zero outside the columns it last had written (written_), so only those are cleared.
@@ -1182,7 +1181,7 @@ bool LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const fl
   if (hi < 0) {
     clear(w0, w1);
     w0 = 0, w1 = -1;
-    return false;
+    return;
   }
   clear(w0, std::min(w1, lo - 2));
   clear(std::max(w0, hi + 2), w1);
@@ -1206,7 +1205,6 @@ bool LayerGroupDitherer::row_(int row, const std::int32_t* const* cell, const fl
             lane_counts);
   for (int l = 0; l < layers_; ++l)
     for (int k = 0; k < group_k; ++k) counts[l][k] += static_cast<std::int64_t>(lane_counts[k][l]);
-  return true;
 }
 
 void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, const float* const* props,
@@ -1217,9 +1215,11 @@ void LayerGroupDitherer::dither_paint(int row, const std::int32_t* const* cell, 
   std::int32_t table[8] = {};
   for (int k = 0; k < group_k; ++k) table[k] = static_cast<std::int32_t>(colours[static_cast<std::size_t>(k)]);
   table[7] = static_cast<std::int32_t>(colours[void_material]);
-  const bool any = row_(row, cell, props, table, counts);
+  int live_lo, live_hi;
+  row_(row, cell, props, table, counts, live_lo, live_hi);
+  const bool any = live_lo <= live_hi;
   const auto nx = static_cast<std::size_t>(nx_);
-  const std::size_t lo = any ? static_cast<std::size_t>(lo_) : nx, hi = any ? static_cast<std::size_t>(hi_) : nx - 1;
+  const std::size_t lo = any ? static_cast<std::size_t>(live_lo) : nx, hi = any ? static_cast<std::size_t>(live_hi) : nx - 1;
   void* outs[8];
   for (int l = 0; l < layers_; ++l) {
     for (std::size_t j = 0; j < lo; ++j) std::memcpy(rgba[l] + 4 * j, &colours[void_material], 4);
@@ -1233,9 +1233,11 @@ void LayerGroupDitherer::dither(int row, const std::int32_t* const* cell, const 
                                 std::int64_t* const* counts) {
   const FlushDenormals flush;
   const std::int32_t table[8] = {0, 1, 2, 3, 4, 0, 0, void_material};
-  const bool any = row_(row, cell, props, table, counts);
+  int live_lo, live_hi;
+  row_(row, cell, props, table, counts, live_lo, live_hi);
+  const bool any = live_lo <= live_hi;
   const auto nx = static_cast<std::size_t>(nx_);
-  const std::size_t lo = any ? static_cast<std::size_t>(lo_) : nx, hi = any ? static_cast<std::size_t>(hi_) : nx - 1;
+  const std::size_t lo = any ? static_cast<std::size_t>(live_lo) : nx, hi = any ? static_cast<std::size_t>(live_hi) : nx - 1;
   std::uint8_t* outs[8];
   for (int l = 0; l < layers_; ++l) {
     std::fill(index[l], index[l] + lo, void_material);

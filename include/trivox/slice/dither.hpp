@@ -184,16 +184,15 @@ public:
 
 private:
   /// One row of the group through the kernel: table[choice] (choice 0..4, 7 for void) per
-  /// column and lane into chosen_ for the columns lo_..hi_ where some layer has a live voxel
-  /// (every other column is void in every layer), the counts added; false when there are none.
-  bool row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
-            std::int64_t* const* counts);
+  /// column and lane into chosen_ for the columns lo..hi where some layer has a live voxel
+  /// (every other column is void in every layer), the counts added; lo > hi when there are none.
+  void row_(int row, const std::int32_t* const* cell, const float* const* props, const std::int32_t (&table)[8],
+            std::int64_t* const* counts, int& lo, int& hi);
   /// Zero error in both halves.
   void clear_errors();
   int nx_, np_, ir_ = 0, ig_ = 0, ib_ = 0;
   int layers_ = 0;
   int next_row_ = 0;
-  int lo_ = 0, hi_ = -1;  // the last row's live columns (row_)
   // Per half of error_, the columns (-1 and nx: the pads) written into it last; zero elsewhere.
   std::array<std::array<int, 2>, 2> written_{{{0, -1}, {0, -1}}};
   // The fs weights per neighbour mask, each broadcast to 8 lanes (an AVX register each).
