@@ -384,6 +384,15 @@ std::string num(double v) {
   return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
 }
 
+/// A checked value (check_config) in plain decimal notation, never with an exponent: readers
+/// of ConfigFile.xml parse 100000 as an integer but not 1e+05 (a 0.1 mm layer's thickness).
+std::string decimal(double v) {
+  char buf[400];  // check_config bounds v to (0, 1e9]: 10 digits before the point, 340 at most after
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed);
+  if (r.ec != std::errc{}) throw Error("ConfigFile.xml: cannot write the number " + num(v) + " in decimal notation");
+  return std::string(buf, r.ptr);
+}
+
 std::string in_quotes(std::string_view s) {
   std::string out;
   out.reserve(s.size() + 2);
@@ -563,9 +572,9 @@ std::string config_xml(const StackConfig& c) {
   pugi::xml_node root = doc.append_child("GCVF");
   text_child(root, "Version", std::to_string(c.version));
   pugi::xml_node res = root.append_child("Resolution");
-  text_child(res, "XDpi", num(c.dpi_x));
-  text_child(res, "YDpi", num(c.dpi_y));
-  text_child(res, "SliceThicknessNanoMeter", num(c.slice_thickness_nm));
+  text_child(res, "XDpi", decimal(c.dpi_x));
+  text_child(res, "YDpi", decimal(c.dpi_y));
+  text_child(res, "SliceThicknessNanoMeter", decimal(c.slice_thickness_nm));
   pugi::xml_node dims = root.append_child("SliceDimensions");
   text_child(dims, "SliceWidth", std::to_string(c.width));
   text_child(dims, "SliceHeight", std::to_string(c.height));

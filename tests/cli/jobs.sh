@@ -77,8 +77,33 @@ wait %1 2>/dev/null || true
 "$trivox" slice models/twisted_column.json -o "$tmp/killed" "${big[@]}" --resume > /dev/null
 "$trivox" slice models/twisted_column.json -o "$tmp/straight" --threads 2 --progress never > /dev/null
 same_folder "$tmp/straight" "$tmp/killed"
+# Killed again, now while --force overwrites that finished job with another: the earlier job's
+# ConfigFile.xml went first, so the folder does not look complete beside a mix of two jobs' slices.
+"$trivox" slice models/twisted_column.json -o "$tmp/killed" "${big[@]}" --force --dither stochastic > /dev/null &
+for _ in $(seq 200); do [ -e "$tmp/killed/ConfigFile.xml" ] || break; sleep 0.05; done   # the new job has begun
+sleep 0.5
+kill -9 %1 2>/dev/null || true
+wait %1 2>/dev/null || true
+"$py" - "$tmp/killed" <<'PY'
+import sys, os, json
+d = sys.argv[1]
+if os.path.exists(os.path.join(d, "ConfigFile.xml")):
+    m = json.load(open(os.path.join(d, "manifest.json")))
+    assert m["complete"] is True and m["options"]["png.dither"] == "stochastic", "ConfigFile.xml of an unfinished job"
+    print("note: the job finished before the kill")
+PY
 
 # 4. Another job in the same folder is refused, naming the difference; --force starts over.
+# --force over a longer job with a VDB (88 layers) by one of 1 mm layers (44) and another
+# dither leaves the folder exactly as the new job alone writes it: no stale slices, VDB or manifest.
+"$trivox" slice $model -o "$tmp/forced" "${grid[@]}" --png --vdb --vdb-voxel 0.5 > /dev/null
+"$trivox" slice $model -o "$tmp/forced" --dpi 100,100 --layer 1 --progress never --dither none --force > /dev/null
+"$trivox" slice $model -o "$tmp/fresh" --dpi 100,100 --layer 1 --progress never --dither none > /dev/null
+same_folder "$tmp/fresh" "$tmp/forced"
+# Files trivox does not write stay.
+echo notes > "$tmp/forced/notes.txt"
+"$trivox" slice $model -o "$tmp/forced" "${grid[@]}" --force > /dev/null
+[ "$(cat "$tmp/forced/notes.txt")" = notes ]
 expect_fail "holds another job" "$trivox" slice $model -o "$resumed" "${grid[@]}" --zip --resume --dither none
 expect_fail "png.dither was fs, now none" "$trivox" slice $model -o "$resumed" "${grid[@]}" --resume --dither none --zip
 expect_fail "--resume to continue" "$trivox" slice $model -o "$resumed" "${grid[@]}" --zip

@@ -26,6 +26,8 @@ TRIVOX_LAYER_GROUP=5 "$trivox" slice models/twisted_column.json -o "$tmp/c5" "${
 TRIVOX_NO_AVX512=1 "$trivox" slice models/twisted_column.json -o "$tmp/c2" "${col[@]}" --threads 2 > /dev/null
 "$trivox" slice models/twisted_column.json -o "$tmp/cs" "${col[@]}" --threads 2 --shard 1/3 > /dev/null
 [ "$(ls "$tmp/c8"/slice_*.png | wc -l)" -gt 20 ]
+# 0.1 mm layers: the thickness in plain decimal (1e+05 once), as integer readers want it.
+grep -q "<SliceThicknessNanoMeter>100000</SliceThicknessNanoMeter>" "$tmp/c8/ConfigFile.xml"
 for d in c8t1 c1 c3 c5 c2; do
   for f in "$tmp"/c8/slice_*.png "$tmp/c8/ConfigFile.xml"; do cmp "$f" "$tmp/$d/$(basename "$f")"; done
 done

@@ -295,6 +295,21 @@ TEST_CASE("ConfigFile.xml round trip, and what pugixml reads in it", "[io][stack
   CHECK(std::string(mats[1].child_value("RGBA")) == "198 0 88 255");
   CHECK(std::string(mats[2].child_value("Name")) == "A&B <white> \"x\"");
 
+  SECTION("round numbers are written without an exponent") {
+    // 0.1 mm layers at 100000 dpi: shortest round-trip notation would give 1e+05, which readers
+    // of an integer field (Python's int, JavaScript's parseInt) reject or misread.
+    c.slice_thickness_nm = 0.1 * 1e6;
+    c.dpi_x = 1e5;
+    c.dpi_y = 2e4;
+    pugi::xml_document d2;
+    REQUIRE(d2.load_string(config_xml(c).c_str()));
+    const pugi::xml_node res = d2.child("GCVF").child("Resolution");
+    CHECK(std::string(res.child_value("SliceThicknessNanoMeter")) == "100000");
+    CHECK(std::string(res.child_value("XDpi")) == "100000");
+    CHECK(std::string(res.child_value("YDpi")) == "20000");
+    CHECK(parse_config_xml(config_xml(c), "ConfigFile.xml") == c);
+  }
+
   SECTION("a flat layout (elements directly under the root) reads too") {
     const std::string flat =
         "<GCVF><Version>1</Version><XDpi>600</XDpi><YDpi>300</YDpi><SliceThicknessNanoMeter>27000"
