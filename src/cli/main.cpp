@@ -4,10 +4,44 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 #include "common.hpp"
 #include "trivox/error.hpp"
 #include "trivox/version.hpp"
+
+namespace {
+
+/// CLI11's parse errors in trivox's words (DESIGN.md: the place, what was found, what was
+/// expected): "--layer abc: not a number; expected a number: <the option's help>".
+std::string usage_message(const CLI::App& app, const CLI::ParseError& e, const char* first_arg) {
+  const auto subs = app.get_subcommands();
+  const CLI::App* sub = subs.empty() ? nullptr : subs.front();
+  if (!sub && first_arg && first_arg[0] != '-') {
+    std::string names;
+    for (const CLI::App* s : app.get_subcommands({})) names += (names.empty() ? "" : ", ") + s->get_name();
+    return std::string(first_arg) + ": unknown command; expected one of " + names + " (trivox --help)";
+  }
+  const std::string help = sub ? "trivox " + sub->get_name() + " --help" : std::string("trivox --help");
+  std::string what = e.what();
+  static const std::string convert = "Could not convert: ";
+  if (dynamic_cast<const CLI::ConversionError*>(&e) && what.starts_with(convert)) {
+    const std::size_t eq = what.find(" = ", convert.size());
+    if (eq != std::string::npos) {
+      const std::string name = what.substr(convert.size(), eq - convert.size()), value = what.substr(eq + 3);
+      const CLI::Option* o = sub ? sub->get_option_no_throw(name) : nullptr;
+      const std::string type = o ? o->get_type_name() : std::string();
+      const char* kind = type == "FLOAT" ? "a number" : type == "INT" ? "a whole number" : type == "UINT" ? "a whole number, 0 or more" : nullptr;
+      if (kind)
+        return name + " " + value + ": not " + kind + "; expected " + kind +
+               (o->get_description().empty() ? std::string() : " (" + o->get_description() + ")");
+    }
+  }
+  if (!what.empty() && what.back() == '.') what.pop_back();
+  return what + "; see " + help;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"trivox: heterogeneous B-spline volumes (V-models) to printable voxels", "trivox"};
@@ -35,7 +69,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    std::fprintf(stderr, "trivox: error: %s\n", usage_message(app, e, argc > 1 ? argv[1] : nullptr).c_str());
     return 2;
   } catch (const trivox::Error& e) {
     std::fprintf(stderr, "trivox: error: %s\n", e.what());

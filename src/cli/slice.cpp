@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -26,7 +27,7 @@ struct Options {
   double layer = 0.0;
   int threads = 0;
   bool zip = false, force = false;
-  std::int64_t max_voxels = 100'000'000'000;
+  double max_voxels = 1e11;  // a double, so that 1e9 reads as the help writes it
   bool png = false, vdb = false;
   double vdb_voxel = 0.0;
   int supersample = 1;
@@ -181,6 +182,8 @@ void add_slice(CLI::App& app, Common& common) {
           throw Error(std::string(o) + ": applies to the PNG stack; expected --png with it (--vdb alone writes only the VDB)");
     if (opt->progress != "auto" && opt->progress != "bar" && opt->progress != "lines" && opt->progress != "never")
       throw Error("--progress " + opt->progress + ": unknown mode; expected auto, bar, lines or never");
+    if (!(opt->max_voxels >= 1 && opt->max_voxels <= 1e18 && std::floor(opt->max_voxels) == opt->max_voxels))
+      throw Error("--max-voxels " + fmt(opt->max_voxels) + ": out of range; expected a whole number of voxels, 1 to 1e18");
     if (opt->threads < 0 || opt->threads > 1024)
       throw Error("--threads " + std::to_string(opt->threads) + ": out of range; expected 1 to 1024 (0: all cores)");
     // The shard: --shard wins over a scheduler's environment (Slurm arrays, Kubernetes).
@@ -300,7 +303,7 @@ void add_slice(CLI::App& app, Common& common) {
     job.model_sha256 = model_sha;
     job.extra_options = vdb_options;
     job.last_output = !want_vdb;  // the VDB follows and completes the manifest
-    job.max_voxels = opt->max_voxels;
+    job.max_voxels = static_cast<std::int64_t>(opt->max_voxels);
     job.resume = opt->resume;
     job.shard = shard;
     job.sampler = sampling;

@@ -104,6 +104,14 @@ struct LayerOut {
 
 namespace {
 
+/// Where --zip packs the folder: DIR.gcvf beside it.
+fs::path zip_path(const fs::path& dir) {
+  fs::path zip = dir;
+  if (!zip.has_filename()) zip = zip.parent_path();
+  zip += ".gcvf";
+  return zip;
+}
+
 /// What --force (without --resume) removes before a job writes anything, so that the folder ends
 /// up holding this job alone and never looks complete while it does not: ConfigFile.xml first (a
 /// stack without it is unfinished to every reader), then the earlier jobs' manifests with the
@@ -195,11 +203,12 @@ namespace {
 /// Bezier form takes seconds).
 std::pair<std::array<slice::Vec3, 2>, slice::VoxelGrid> box_and_grid(
     const vmodel::VModel& model, const slice::PrintProfile& profile,
-    const std::optional<std::array<slice::Vec3, 2>>& known = std::nullopt) {
+    const std::optional<std::array<slice::Vec3, 2>>& known = std::nullopt, const std::string& name = "the model") {
   if (model.cells.empty())
-    throw Error("the model has no cells; expected at least one volumetric cell to slice");
+    throw Error(name + ": no cells; expected at least one volumetric cell (a trivariate) to slice");
   check_profile(profile);
   const auto box = known ? *known : slice::model_bounds(model);
+  slice::check_solid_box(box[0], box[1], name);
   return {box, slice::VoxelGrid::covering(box[0], box[1], {profile.pitch_x(), profile.pitch_y(), profile.pitch_z()})};
 }
 }  // namespace
@@ -210,7 +219,7 @@ slice::VoxelGrid slice_grid(const vmodel::VModel& model, const slice::PrintProfi
 
 SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions& opt, const SliceProgress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  const auto box_grid = box_and_grid(model, opt.profile, opt.model_box);
+  const auto box_grid = box_and_grid(model, opt.profile, opt.model_box, opt.model_name);
   const auto& box = box_grid.first;
   const slice::VoxelGrid& grid = box_grid.second;
 
@@ -234,7 +243,14 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
 
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
-  const slice::MaterialMapper mapper(palette, model.properties);
+  const slice::MaterialMapper mapper = [&] {
+    try {
+      return slice::MaterialMapper(palette, model.properties);
+    } catch (const Error& e) {  // a palette that lacks what the model's properties need: name its file
+      if (opt.palette) throw e.within(opt.palette->string());
+      throw;
+    }
+  }();
   const slice::DitherMode mode = slice::parse_dither_mode(opt.dither);
 
   // Every dithering mode reads a voxel's cell before its properties, so void voxels' need not
@@ -275,6 +291,18 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
   manifest.shard = opt.shard;
   manifest.layer_range = opt.shard.range(nz);
+  // The archive's place is checked before the slices are written, not after.
+  if (opt.zip) {
+    const fs::path zip = zip_path(opt.out_dir);
+    std::error_code ec;
+    if (fs::is_directory(zip, ec))
+      throw Error(zip.string() + ": is a folder; expected a .gcvf file path to write (--zip packs DIR as DIR.gcvf)");
+    // A non-empty folder without --force or --resume is refused below, with its own reason;
+    // shards' archive is merge's to write.
+    const bool fresh = !fs::exists(opt.out_dir, ec) || fs::is_empty(opt.out_dir, ec);
+    if (fs::exists(zip, ec) && fresh && !opt.force && !opt.resume && opt.shard.count == 1)
+      throw Error(zip.string() + ": exists; expected a new archive (--force to replace it, or another output folder)");
+  }
   const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt.force, opt.resume);
   StackConfig cfg = stack_config_of(manifest, {});
 
@@ -523,9 +551,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     write_file_atomically(opt.out_dir / "ConfigFile.xml", config);
     manifest.files.push_back({"config", "ConfigFile.xml", sha256_hex(config)});
     if (opt.zip) {
-      fs::path zip = opt.out_dir;
-      if (!zip.has_filename()) zip = zip.parent_path();
-      zip += ".gcvf";
+      const fs::path zip = zip_path(opt.out_dir);
       zip_stack(opt.out_dir, zip);
       sum.zip_file = zip;
       manifest.files.push_back({"zip", "../" + zip.filename().string(), sha256_file(zip)});

@@ -266,7 +266,8 @@ std::pair<std::int64_t, std::string> write_vdb_file(const fs::path& path, const 
 
 VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
   if (model.cells.empty())
-    throw Error("the model has no cells; expected at least one volumetric cell to sample");
+    throw Error((opt.model_file.empty() ? std::string("the model") : opt.model_file.string()) +
+                ": no cells; expected at least one volumetric cell (a trivariate) to sample");
   if (opt.supersample < 1 || opt.supersample > 8)
     throw Error("--supersample " + std::to_string(opt.supersample) + ": out of range; expected 1 to 8 (N^3 samples per voxel)");
   if (opt.voxel_mm && !(std::isfinite(*opt.voxel_mm) && *opt.voxel_mm > 0.0))
@@ -274,6 +275,7 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
   VdbPlan plan;
   plan.supersample = opt.supersample;
   const auto box = opt.model_box ? *opt.model_box : slice::model_bounds(model);
+  slice::check_solid_box(box[0], box[1], opt.model_file.empty() ? std::string("the model") : opt.model_file.string());
   plan.origin = box[0];
   plan.model_box = box;
 
@@ -337,7 +339,14 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const auto t0 = std::chrono::steady_clock::now();
   const VdbPlan plan = plan_vdb_job(model, opt);
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
-  const slice::MaterialMapper mapper(palette, model.properties);
+  const slice::MaterialMapper mapper = [&] {
+    try {
+      return slice::MaterialMapper(palette, model.properties);
+    } catch (const Error& e) {  // a palette that lacks what the model's properties need: name its file
+      if (opt.palette) throw e.within(opt.palette->string());
+      throw;
+    }
+  }();
   const Layout layout = make_layout(model, palette);
   const std::string model_sha =
       !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : sha256_file(opt.model_file);

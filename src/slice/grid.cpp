@@ -53,4 +53,20 @@ VoxelGrid VoxelGrid::covering(const std::array<double, 3>& lo, const std::array<
   return g;
 }
 
+void check_solid_box(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const std::string& name) {
+  static constexpr const char* axis = "xyz";
+  const auto g = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  for (std::size_t d = 0; d < 3; ++d) {
+    const double extent = hi[d] - lo[d];
+    if (!(std::isfinite(lo[d]) && std::isfinite(hi[d]) && extent > 0.0))
+      throw Error(name + ": the model's box is " + g(extent) + " mm along " + axis[d] + " (from " + g(lo[d]) + " to " +
+                  g(hi[d]) +
+                  "); expected a solid with extent along x, y and z (a flat or collapsed cell has no volume to print)");
+  }
+}
+
 }  // namespace trivox::slice

@@ -85,7 +85,35 @@ expect_fail "expected fs, stochastic or none" "$trivox" slice models/gismo/fiche
 expect_fail "voxels" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x5" --max-voxels 100
 echo '{"materials": 3}' > "$tmp/bad-palette.json"
 expect_fail "bad-palette.json" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x6" --palette "$tmp/bad-palette.json"
-expect_fail "no cells" "$trivox" slice models/gismo/teapot.xml -o "$tmp/x7"
+expect_fail "teapot.xml: no cells; expected" "$trivox" slice models/gismo/teapot.xml -o "$tmp/x7"
+# A well-formed palette that lacks the colour materials an r, g, b model needs: its file is named.
+echo '{"trivox_palette": 1, "materials": [{"name": "A", "rgba": [1, 2, 3]}]}' > "$tmp/mono.json"
+expect_fail "mono.json: .*the palette lacks VeroCyan-V" "$trivox" slice models/twisted_column.json -o "$tmp/x8" --palette "$tmp/mono.json"
+# Option values CLI11 cannot convert, and values out of range, in trivox's words.
+expect_fail "trivox: error: --layer abc: not a number; expected a number" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x9" --layer abc
+expect_fail "trivox: error: --threads 1.5: not a whole number" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x9" --threads 1.5
+expect_fail "trivox: error: --max-voxels -5: out of range; expected a whole number of voxels" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x9" --max-voxels -5
+expect_fail "trivox: error: --output is required; see trivox slice --help" "$trivox" slice models/gismo/fichera.xml
+expect_fail "trivox: error: slise: unknown command; expected one of info, eval" "$trivox" slise models/gismo/fichera.xml
+# --max-voxels as the help writes its default: 1e3 is a thousand.
+expect_fail "expected at most 1000 voxels" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x9" --dpi 100,100 --max-voxels 1e3
+# A model without volume (every point on the plane z = 0) is refused, not sliced to nothing.
+"$py" -c "
+import json, sys
+pts = [[x, y, 0] for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+json.dump({'trivox': 1, 'units': 'mm', 'properties': [], 'cells': [{'name': 'p', 'trivariate': {
+    'orders': [2, 2, 2], 'knots': [[0, 0, 1, 1]] * 3, 'points': pts}}]}, open(sys.argv[1], 'w'))" "$tmp/flat.json"
+expect_exit 2 "flat.json: the model's box is 0 mm along z" "$tmp/x10" "$trivox" slice "$tmp/flat.json" -o "$tmp/x10"
+expect_exit 2 "flat.json: the model's box is 0 mm along z" "$tmp/x10" "$trivox" slice "$tmp/flat.json" -o "$tmp/x10" --vdb
+# --zip: the archive's place is checked before any slice is written; an archive there is kept
+# unless --force.
+mkdir -p "$tmp/x11.gcvf/sub"
+expect_exit 2 "x11.gcvf: is a folder; expected a .gcvf file" "$tmp/x11" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x11" --zip
+rm -r "$tmp/x11.gcvf"; echo precious > "$tmp/x11.gcvf"
+expect_exit 2 "x11.gcvf: exists; expected a new archive" "$tmp/x11" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x11" --zip
+[ "$(cat "$tmp/x11.gcvf")" = precious ]
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/x11" --dpi 100,100 --zip --force --progress never > /dev/null
+unzip -l "$tmp/x11.gcvf" > "$tmp/x11.list"; grep -q ConfigFile.xml "$tmp/x11.list"
 # --force overwrites.
 "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never --force > /dev/null
 echo "cli slice: ok"

@@ -342,7 +342,7 @@ expect_fail "expected --png with it" "$trivox" slice models/gismo/fichera.xml -o
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --png --vdb --supersample 9 --dpi 100,100
 [ ! -e "$tmp/x1" ]                                        # nothing written, not even the PNG stack
 expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --vdb --vdb-voxel 0.25
-expect_fail "no cells" "$trivox" slice models/gismo/teapot.xml -o "$tmp/x2" --vdb
+expect_fail "teapot.xml: no cells; expected" "$trivox" slice models/gismo/teapot.xml -o "$tmp/x2" --vdb
 expect_fail "missing.vdb: no such file" "$trivox" inspect "$tmp/missing.vdb"
 # A damaged name (a byte that is not UTF-8) still reads, and prints as JSON.
 "$py" -c 'import sys; b = open(sys.argv[1], "rb").read(); open(sys.argv[2], "wb").write(b.replace(b"density", b"\xffensity"))' \

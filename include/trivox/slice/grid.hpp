@@ -59,4 +59,11 @@ struct VoxelGrid {
                             const std::array<double, 3>& pitch);
 };
 
+/// Refuses a model box without volume: a point, or a box of zero extent along some axis (every
+/// cell flat, say), where nothing would print although the job would run.
+/// @param lo, hi  the model's bounding box, mm
+/// @param name    the model (its file) for the message
+/// @throws Error (bad_input) naming the axis and the extent; also for a non-finite box
+void check_solid_box(const std::array<double, 3>& lo, const std::array<double, 3>& hi, const std::string& name);
+
 }  // namespace trivox::slice
