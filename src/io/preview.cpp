@@ -265,6 +265,12 @@ PreviewSummary write_preview(const fs::path& dir, const fs::path& png, int every
     }
   }
 
+  // The section's red rows too: every slice the picture marks, not only the contact sheet's.
+  for (std::size_t li = 0; li < layers.size(); ++li)
+    if (means[li].empty()) sum.unreadable.push_back(c.start_index + layers[li]);
+  std::sort(sum.unreadable.begin(), sum.unreadable.end());
+  sum.unreadable.erase(std::unique(sum.unreadable.begin(), sum.unreadable.end()), sum.unreadable.end());
+
   write_file_atomically(png, encode_png_rgba(cv.px.data(), cv.width, cv.height, 0, 0, 6));
   sum.width = width;
   sum.height = height;

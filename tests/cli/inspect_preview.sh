@@ -125,6 +125,9 @@ grep -q "stack is INVALID" "$tmp/broken.txt"
 # preview still draws it, crossing out what it cannot read.
 "$trivox" preview "$tmp/broken" -o "$tmp/broken.png" --json > "$tmp/bp.json"
 "$py" -c "import json,sys; s=json.load(open(sys.argv[1])); assert s['unreadable']==[2,4], s" "$tmp/bp.json"
+# With every third slice on the sheet (0, 3), the section's red rows still name 2 and 4.
+"$trivox" preview "$tmp/broken" -o "$tmp/broken3.png" --every 3 --json > "$tmp/bp3.json"
+"$py" -c "import json,sys; s=json.load(open(sys.argv[1])); assert s['shown']==[0,3] and s['unreadable']==[2,4], s" "$tmp/bp3.json"
 
 # A recorded VoxelCount that the pixels contradict: exit 1.
 cp -r "$tmp/stack" "$tmp/miscount"

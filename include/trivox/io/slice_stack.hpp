@@ -199,7 +199,8 @@ struct PreviewSummary {
   int width = 0, height = 0;      ///< of the picture
   int every = 0;                  ///< slice step of the contact sheet
   std::vector<int> shown;         ///< slice numbers on the contact sheet
-  std::vector<int> unreadable;    ///< those of them missing or corrupt (crossed out)
+  std::vector<int> unreadable;    ///< slices missing or corrupt, ascending: those on the sheet (crossed
+                                  ///< out) and those the cross-section needed (red rows)
   int section_row = 0;            ///< image row of the slices the cross-section goes through
   int section_width = 0, section_height = 0;  ///< size of the cross-section in the picture
   int section_z_scale = 1;        ///< vertical exaggeration of the section (1: true proportions)
