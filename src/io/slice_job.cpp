@@ -43,12 +43,14 @@ std::string human_bytes(double b) {
   return buf;
 }
 
+/// A number as a user would type it: 0.027, not 0.027000.
+std::string text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return std::string(buf);
+}
+
 void check_profile(const slice::PrintProfile& p) {
-  const auto text = [](double v) {  // as a user would type it: 0.027, not 0.027000
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return std::string(buf);
-  };
   if (!(std::isfinite(p.dpi_x) && std::isfinite(p.dpi_y) && p.dpi_x >= 10 && p.dpi_x <= 10000 && p.dpi_y >= 10 &&
         p.dpi_y <= 10000))
     throw Error("--dpi " + text(p.dpi_x) + "," + text(p.dpi_y) +
@@ -233,8 +235,8 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     for (int d = 0; d < 3; ++d) {
       const auto dd = static_cast<std::size_t>(d);
       if (box[1][dd] - box[0][dd] > opt.profile.tray_mm[dd])
-        throw Error(opt.model_name + ": the model is " + std::to_string(box[1][dd] - box[0][dd]) + " mm along " + axis[d] +
-                    ", larger than the " + opt.profile.name + " tray (" + std::to_string(opt.profile.tray_mm[dd]) +
+        throw Error(opt.model_name + ": the model is " + text(box[1][dd] - box[0][dd]) + " mm along " + axis[d] +
+                    ", larger than the " + opt.profile.name + " tray (" + text(opt.profile.tray_mm[dd]) +
                     " mm); expected a model that fits (or --force). Job: " + estimate);
     }
     if (grid.voxels() > opt.max_voxels)

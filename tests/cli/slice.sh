@@ -76,7 +76,28 @@ for rgba, (name, cfg_count, seen) in palette.items():
 assert summary["filled"] == 448 and summary["inversion_failures"] == 0, summary
 PY
 
+# The J850 preset: 600 x 300 dpi and 27 um layers, as the J750's; --progress lines reports the
+# first layer (ETA not yet known) and the last, on stderr, beside a JSON summary on stdout.
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/j850" --printer j850 --progress lines --json > "$tmp/j850.json" 2> "$tmp/j850.err"
+"$py" - "$tmp/j850.json" <<'PY'
+import sys, json
+s = json.load(open(sys.argv[1]))
+assert s["printer"] == "j850" and s["dpi"] == [600, 300] and s["layer_mm"] == 0.027, s
+assert s["grid"]["pitch"] == [25.4 / 600, 25.4 / 300, 0.027] and s["grid"]["count"] == [48, 24, 75], s["grid"]
+PY
+grep -q "trivox slice: 1/75 layers, .* ETA --" "$tmp/j850.err"
+grep -q "trivox slice: 75/75 layers" "$tmp/j850.err"
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/quiet" --dpi 100,100 --progress never 2> "$tmp/quiet.err" > /dev/null
+[ ! -s "$tmp/quiet.err" ]
+
 # Refusals: exit 2 with the reason.
+# A model wider than the tray (a 500 mm box; the J750's tray is 490 x 390 x 200 mm), with the job's size.
+"$py" -c "
+import json, sys
+pts = [[500 * x, 10 * y, 10 * z] for z in (0, 1) for y in (0, 1) for x in (0, 1)]
+json.dump({'trivox': 1, 'units': 'mm', 'properties': [], 'cells': [{'name': 'bar', 'trivariate': {
+    'orders': [2, 2, 2], 'knots': [[0, 0, 1, 1]] * 3, 'points': pts}}]}, open(sys.argv[1], 'w'))" "$tmp/bar.json"
+expect_exit 2 "bar.json: the model is 500 mm along x, larger than the j750 tray (490 mm); expected a model that fits (or --force). Job: 11812 x 119 x 371" "$tmp/x12" "$trivox" slice "$tmp/bar.json" -o "$tmp/x12"
 expect_fail "not empty" "$trivox" slice models/gismo/fichera.xml -o "$tmp/f1" --dpi 100,100 --layer 0.254 --progress never
 expect_fail "unknown printer" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --printer j9000
 expect_fail "--dpi 0,100: out of range; expected 10 to 10000" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x2" --dpi 0,100
