@@ -1,6 +1,7 @@
 /// @file src/io/png_rows.hpp
 /// @brief (private to src/io) Streaming a slice PNG row by row as 8-bit RGBA, and finding the
-/// slice files of a stack folder. OpenImageIO stays behind the pimpl, out of this header.
+/// slice files of a stack folder. The decoding is the PNG module's (png_codec.hpp), behind the
+/// pimpl.
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -19,6 +20,8 @@ namespace trivox::io::detail {
 class PngRowReader {
 public:
   /// Opens `path`; on failure ok() is false and error() says why.
+  /// @throws trivox::Error (failed) when the PNG module cannot be loaded (png_codec()), which is
+  ///         tried only for a file whose chunk structure is intact
   explicit PngRowReader(const std::filesystem::path& path);
   ~PngRowReader();
   PngRowReader(const PngRowReader&) = delete;

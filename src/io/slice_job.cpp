@@ -18,6 +18,7 @@
 #include <system_error>
 #include <time.h>
 
+#include "png_codec.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
 #include "png_rows.hpp"
@@ -243,6 +244,10 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       throw Error(opt.model_name + ": the job has " + estimate + "; expected at most " + std::to_string(opt.max_voxels) +
                   " voxels (raise --max-voxels or use --force)");
   }
+
+  // The PNG module now (png_codec.hpp): when it cannot be loaded the job stops here, before a
+  // folder is made or a layer sampled.
+  (void)detail::png_codec();
 
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
   const slice::MaterialMapper mapper = [&] {

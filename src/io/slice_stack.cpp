@@ -1,9 +1,8 @@
-// Voxel Print stacks: PNG encoding and decoding (OpenImageIO), ConfigFile.xml (pugixml), the
-// .gcvf zip (libzip), and the row reader that inspection and previews share.
+// Voxel Print stacks: PNG encoding and decoding (OpenImageIO, through the module that
+// png_codec() loads), ConfigFile.xml (pugixml), the .gcvf zip (libzip), and the row reader that
+// inspection and previews share.
 #include "trivox/io/slice_stack.hpp"
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 #include <fcntl.h>
 #include <unistd.h>
 #include <zip.h>
@@ -27,6 +26,7 @@
 #include <sstream>
 #include <thread>
 
+#include "png_codec.hpp"
 #include "png_rows.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
@@ -81,8 +81,7 @@ std::map<long long, std::string> list_slices(const fs::path& dir, const std::str
 
 struct PngRowReader::Impl {
   std::string bytes;                 // the whole file: checked, then decoded from memory
-  std::unique_ptr<OIIO::Filesystem::IOMemReader> proxy;
-  std::unique_ptr<OIIO::ImageInput> in;
+  std::unique_ptr<PngDecoder> in;    // reads `bytes`: declared after it, destroyed before it
   std::vector<std::uint8_t> native;  // chunk rows as stored (3 or 4 channels)
   std::vector<std::uint8_t> rgba;    // chunk rows expanded to RGBA (3-channel files only)
   int rows_per_chunk = 1;
@@ -146,33 +145,23 @@ PngRowReader::PngRowReader(const fs::path& path) : impl_(std::make_unique<Impl>(
   }
   error_ = png_structure_problem(impl_->bytes);
   if (!error_.empty()) return;
-  impl_->proxy = std::make_unique<OIIO::Filesystem::IOMemReader>(impl_->bytes.data(), impl_->bytes.size());
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);  // keep colours as stored, never premultiply
-  OIIO::Filesystem::IOProxy* proxy = impl_->proxy.get();
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  impl_->in = OIIO::ImageInput::open(path.string(), &config, proxy);
+  std::string why;
+  impl_->in = png_codec().decoder(impl_->bytes.data(), impl_->bytes.size(), path.string(), why);
   if (!impl_->in) {
-    const std::string why = OIIO::geterror();
     error_ = "unreadable PNG: " + (why.empty() ? std::string("cannot open") : why) + "; expected a complete PNG file";
     return;
   }
-  const OIIO::ImageSpec& spec = impl_->in->spec();
+  const PngSpec& spec = impl_->in->spec();
   width_ = spec.width;
   height_ = spec.height;
-  channels_ = spec.nchannels;
-  bits_ = static_cast<int>(spec.format.size() * 8);
+  channels_ = spec.channels;
+  bits_ = spec.bits;
   if (width_ <= 0 || height_ <= 0) error_ = "an empty image; expected a slice";
   // About 1 MB of rows per read: few calls into OpenImageIO, little memory.
   impl_->rows_per_chunk = std::clamp<int>(static_cast<int>((1 << 20) / (std::max(width_, 1) * 4LL)), 1, 256);
 }
 
-PngRowReader::~PngRowReader() {
-  if (impl_ && impl_->in) {
-    impl_->in->close();
-    (void)impl_->in->geterror();  // nothing may stay pending (OpenImageIO would print it)
-  }
-}
+PngRowReader::~PngRowReader() = default;  // the decoder closes the file
 
 std::string PngRowReader::format_problem() const {
   if (bits_ != 8 || (channels_ != 3 && channels_ != 4))
@@ -194,8 +183,8 @@ const std::uint8_t* PngRowReader::row(int y) {
     m.end = std::min(height_, y + m.rows_per_chunk);
     const int nc = std::min(channels_, 4);
     m.native.resize(w * static_cast<std::size_t>(m.end - m.begin) * static_cast<std::size_t>(nc));
-    if (!m.in->read_scanlines(0, 0, m.begin, m.end, 0, 0, nc, OIIO::TypeDesc::UINT8, m.native.data())) {
-      const std::string why = m.in->geterror();
+    if (!m.in->rows(m.begin, m.end, nc, m.native.data())) {
+      const std::string why = m.in->error();
       error_ = "corrupt PNG data (rows " + std::to_string(m.begin) + ".." + std::to_string(m.end - 1) + " of " +
                std::to_string(height_) + "): " + (why.empty() ? std::string("cannot decode") : why) +
                "; expected a complete PNG file";
@@ -224,51 +213,51 @@ const std::uint8_t* PngRowReader::row(int y) {
 
 namespace {
 
-/// An OpenImageIO PNG encoder into memory with the slices' settings (encode_png_rgba's comment).
-class PngEncoder {
+/// A PNG encoder into memory with the slices' settings (encode_png_rgba's comment): the module's
+/// encoder, its failures turned into trivox::Error.
+class SlicePngWriter {
 public:
-  PngEncoder(int width, int height, double dpi_x, double dpi_y, int level) : proxy_(buffer_) {
+  SlicePngWriter(int width, int height, double dpi_x, double dpi_y, int level) {
     if (width <= 0 || height <= 0)
       throw Error("PNG of " + std::to_string(width) + " x " + std::to_string(height) +
                   " pixels; expected a positive width and height");
     if (level < 0 || level > 9) throw Error("PNG zlib level " + std::to_string(level) + "; expected 0..9");
-    OIIO::ImageSpec spec(width, height, 4, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:UnassociatedAlpha", 1);  // the pixels are final colours: store them as given
-    spec.attribute("png:compressionLevel", level);
-    spec.attribute("png:filter", 0x08);  // PNG_FILTER_NONE (png.h): no per-row filter trials
+    detail::PngEncodeSettings settings;
+    settings.width = width;
+    settings.height = height;
+    settings.level = level;
     if (dpi_x > 0 && dpi_y > 0) {
       // pHYs holds whole pixels per metre and OpenImageIO truncates: hand it the rounded value
       // (exact in a float below 2^24, i.e. any dpi up to 400000).
-      spec.attribute("ResolutionUnit", "m");
-      spec.attribute("XResolution", static_cast<float>(std::round(dpi_x / 0.0254)));
-      spec.attribute("YResolution", static_cast<float>(std::round(dpi_y / 0.0254)));
+      settings.phys = true;
+      settings.pixels_per_metre_x = static_cast<float>(std::round(dpi_x / 0.0254));
+      settings.pixels_per_metre_y = static_cast<float>(std::round(dpi_y / 0.0254));
     }
-    buffer_.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) / 16 + 4096);
-    out_ = OIIO::ImageOutput::create("png", &proxy_);
-    if (!out_) throw Error("PNG encoder unavailable: " + OIIO::geterror(), ErrorKind::failed);
-    if (!out_->open("slice.png", spec)) fail();
+    std::string why;
+    out_ = detail::png_codec().encoder(why);
+    if (!out_) throw Error("PNG encoder unavailable: " + why, ErrorKind::failed);
+    if (!out_->open(settings)) fail();
   }
   /// The whole image, rows top to bottom.
   void image(const std::uint8_t* rgba) {
-    if (!out_->write_image(OIIO::TypeDesc::UINT8, rgba)) fail();
+    if (!out_->image(rgba)) fail();
   }
   /// Rows [y0, y1), in order.
   void rows(int y0, int y1, const std::uint8_t* rgba) {
-    if (!out_->write_scanlines(y0, y1, 0, OIIO::TypeDesc::UINT8, rgba)) fail();
+    if (!out_->rows(y0, y1, rgba)) fail();
   }
   std::string finish() {
-    if (!out_->close()) fail();
-    return std::string(buffer_.begin(), buffer_.end());
+    std::string png;
+    if (!out_->finish(png)) fail();
+    return png;
   }
 
 private:
   [[noreturn]] void fail() {
-    std::string why = out_->geterror();
+    std::string why = out_->error();
     throw Error("PNG encoding failed: " + (why.empty() ? std::string("unknown error") : why), ErrorKind::failed);
   }
-  std::vector<unsigned char> buffer_;
-  OIIO::Filesystem::IOVecOutput proxy_;
-  std::unique_ptr<OIIO::ImageOutput> out_;
+  std::unique_ptr<detail::PngEncoder> out_;
 };
 
 /// rgba[4 j ..] = colours[index[j]] for j < n.
@@ -313,14 +302,14 @@ void paint(const std::uint8_t* index, std::size_t n, const std::array<std::uint3
 }  // namespace
 
 std::string encode_png_rgba(const std::uint8_t* rgba, int width, int height, double dpi_x, double dpi_y, int level) {
-  PngEncoder enc(width, height, dpi_x, dpi_y, level);
+  SlicePngWriter enc(width, height, dpi_x, dpi_y, level);
   enc.image(rgba);
   return enc.finish();
 }
 
 std::string encode_png_indexed(const std::uint8_t* index, int width, int height, const std::array<std::uint32_t, 256>& colours,
                                double dpi_x, double dpi_y, int level) {
-  PngEncoder enc(width, height, dpi_x, dpi_y, level);
+  SlicePngWriter enc(width, height, dpi_x, dpi_y, level);
   // Strips of rows painted into a buffer that stays in the L1/L2 cache while libpng reads it.
   const auto w = static_cast<std::size_t>(width);
   const int strip = std::max(1, static_cast<int>(32768 / w));
@@ -335,27 +324,20 @@ std::string encode_png_indexed(const std::uint8_t* index, int width, int height,
 
 RgbaImage decode_png_rgba(std::string_view bytes, const std::string& source) {
   if (const std::string p = detail::png_structure_problem(bytes); !p.empty()) throw Error(source + ": " + p);
-  OIIO::Filesystem::IOMemReader proxy(const_cast<char*>(bytes.data()), bytes.size());
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);
-  // The plugin's open() takes the proxy from the configuration (and drops one passed otherwise).
-  OIIO::Filesystem::IOProxy* proxy_ptr = &proxy;
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy_ptr);
-  auto in = OIIO::ImageInput::open("memory.png", &config, &proxy);
-  if (!in) throw Error(source + ": not a readable PNG: " + OIIO::geterror() + "; expected a complete PNG file");
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.nchannels != 3 && spec.nchannels != 4)
-    throw Error(source + ": " + std::to_string(spec.nchannels) + " channels; expected RGB or RGBA");
+  std::string why;
+  const auto in = detail::png_codec().decoder(bytes.data(), bytes.size(), "memory.png", why);
+  if (!in) throw Error(source + ": not a readable PNG: " + why + "; expected a complete PNG file");
+  const detail::PngSpec& spec = in->spec();
+  if (spec.channels != 3 && spec.channels != 4)
+    throw Error(source + ": " + std::to_string(spec.channels) + " channels; expected RGB or RGBA");
   RgbaImage img;
   img.width = spec.width;
   img.height = spec.height;
   const std::size_t n = static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height);
-  std::vector<std::uint8_t> native(n * static_cast<std::size_t>(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, native.data())) {
-    const std::string why = in->geterror();
-    throw Error(source + ": cannot decode: " + why + "; expected a complete PNG file");
-  }
-  if (spec.nchannels == 4) {
+  std::vector<std::uint8_t> native(n * static_cast<std::size_t>(spec.channels));
+  if (!in->image(spec.channels, native.data()))
+    throw Error(source + ": cannot decode: " + in->error() + "; expected a complete PNG file");
+  if (spec.channels == 4) {
     img.pixels = std::move(native);
   } else {
     img.pixels.resize(n * 4);
@@ -365,13 +347,12 @@ RgbaImage decode_png_rgba(std::string_view bytes, const std::string& source) {
     }
   }
   // OpenImageIO reports pHYs in the unit it names; convert to pixels per inch.
-  const std::string unit = spec.get_string_attribute("ResolutionUnit");
-  const double xr = spec.get_float_attribute("XResolution", 0.0f), yr = spec.get_float_attribute("YResolution", 0.0f);
+  const std::string& unit = spec.resolution_unit;
+  const double xr = spec.x_resolution, yr = spec.y_resolution;
   const double to_inch = unit == "inch" || unit == "in" ? 1.0 : unit == "cm" ? 2.54 : unit == "m" || unit == "meter" ? 0.0254 : 0.0;
   img.dpi_x = xr * to_inch;
   img.dpi_y = yr * to_inch;
-  in->close();
-  return img;
+  return img;  // the decoder closes the file
 }
 
 // ------------------------------------------------------------------------------------------------

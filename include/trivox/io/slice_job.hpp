@@ -114,8 +114,8 @@ std::optional<Manifest> prepare_job_folder(const std::filesystem::path& dir, con
 void finish_manifest(const std::filesystem::path& dir, const Shard& shard, const std::vector<ManifestFile>& files);
 
 /// Runs the job. @throws Error (bad_input) for bad options, an unusable output folder, a job
-/// larger than the tray or max_voxels (unless force), a malformed palette; (failed) when writing
-/// fails midway.
+/// larger than the tray or max_voxels (unless force), a malformed palette; (failed) when the PNG
+/// module cannot be loaded (checked before the folder is made) or writing fails midway.
 SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions& options,
                               const SliceProgress& progress = {});
 

@@ -68,7 +68,9 @@ struct StackConfig {
 };
 
 /// PNG bytes of an 8-bit RGBA image, through OpenImageIO, in memory (Filesystem::IOVecOutput),
-/// so the caller can checksum them and write them with write_file_atomically.
+/// so the caller can checksum them and write them with write_file_atomically. OpenImageIO is
+/// reached through the PNG module `libtrivox_png.so`, loaded by the first PNG call (docs/cli.md,
+/// "The PNG module"); all PNG functions here throw trivox::Error (failed) when it cannot be.
 ///
 /// Settings (fixed, so the same pixels always give the same bytes): zlib level 1, no PNG row
 /// filter. Measured on a full-tray J750 slice (11575 x 4606, tools/bench/bench_png.cpp, one
@@ -84,7 +86,7 @@ struct StackConfig {
 ///                      nearest integer, as PNG requires); 0 or less: no pHYs chunk
 /// @param level         zlib level 0..9 (the default 1 is the one slices use; previews use 6)
 /// @throws trivox::Error (bad_input) on a non-positive size or a level outside 0..9;
-///         (failed) when OpenImageIO reports an error
+///         (failed) when OpenImageIO reports an error or the PNG module cannot be loaded
 std::string encode_png_rgba(const std::uint8_t* rgba, int width, int height, double dpi_x, double dpi_y,
                             int level = 1);
 
@@ -109,7 +111,7 @@ struct RgbaImage {
 /// alpha 255. Cost: one decode, the whole image in memory.
 /// @param source  a name for messages
 /// @throws trivox::Error (bad_input) naming `source` for bytes that are not a complete PNG, or a
-///         PNG with other than 3 or 4 channels
+///         PNG with other than 3 or 4 channels; (failed) when the PNG module cannot be loaded
 RgbaImage decode_png_rgba(std::string_view bytes, const std::string& source);
 
 /// `ConfigFile.xml` text for `config` (UTF-8, 2-space indented; names are XML-escaped):
@@ -191,7 +193,8 @@ struct StackReport {
 /// Voxels are counted per material over readable slices (foreign pixels are not counted).
 /// Cost: one decode of every slice; memory per thread: one compressed slice and about 1 MB of rows.
 /// @throws trivox::Error (bad_input) only when the folder or its ConfigFile.xml is unusable
-///         (read_stack_config); slice problems are reported, never thrown
+///         (read_stack_config); slice problems are reported, never thrown; (failed) when the
+///         PNG module cannot be loaded
 StackReport inspect_stack(const std::filesystem::path& dir);
 
 /// What write_preview drew.
@@ -219,7 +222,8 @@ struct PreviewSummary {
 /// @param every  slice step; 0 picks ceil(slices / 16) (about 16 thumbnails)
 /// @param width  picture width in pixels (64..16384)
 /// @throws trivox::Error (bad_input) for an unusable folder or ConfigFile.xml, `every` < 0,
-///         `width` out of range, more than 1024 thumbnails, or a picture over 32768 pixels tall
+///         `width` out of range, more than 1024 thumbnails, or a picture over 32768 pixels tall;
+///         (failed) when the PNG module cannot be loaded
 PreviewSummary write_preview(const std::filesystem::path& dir, const std::filesystem::path& png, int every = 0,
                              int width = 1600);
 
