@@ -250,14 +250,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   (void)detail::png_codec();
 
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
-  const slice::MaterialMapper mapper = [&] {
-    try {
-      return slice::MaterialMapper(palette, model.properties);
-    } catch (const Error& e) {  // a palette that lacks what the model's properties need: name its file
-      if (opt.palette) throw e.within(opt.palette->string());
-      throw;
-    }
-  }();
+  const slice::MaterialMapper mapper(palette, model.properties, opt.palette ? opt.palette->string() : std::string());
   const slice::DitherMode mode = slice::parse_dither_mode(opt.dither);
 
   // Every dithering mode reads a voxel's cell before its properties, so void voxels' need not

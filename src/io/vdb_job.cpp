@@ -339,14 +339,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const auto t0 = std::chrono::steady_clock::now();
   const VdbPlan plan = plan_vdb_job(model, opt);
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
-  const slice::MaterialMapper mapper = [&] {
-    try {
-      return slice::MaterialMapper(palette, model.properties);
-    } catch (const Error& e) {  // a palette that lacks what the model's properties need: name its file
-      if (opt.palette) throw e.within(opt.palette->string());
-      throw;
-    }
-  }();
+  const slice::MaterialMapper mapper(palette, model.properties, opt.palette ? opt.palette->string() : std::string());
   const Layout layout = make_layout(model, palette);
   const std::string model_sha =
       !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : sha256_file(opt.model_file);

@@ -317,6 +317,13 @@ MaterialMapper::MaterialMapper(const Palette& palette, const std::vector<std::st
   describe_ = std::move(text);
 }
 
+MaterialMapper::MaterialMapper(const Palette& palette, const std::vector<std::string>& property_names,
+                               const std::string& source) try : MaterialMapper(palette, property_names) {
+} catch (const Error& e) {
+  if (source.empty()) throw;
+  throw e.within(source);
+}
+
 void MaterialMapper::fractions(const float* props, float* out) const noexcept {
   std::fill(out, out + materials_, 0.0f);
   float sum = 0.0f;

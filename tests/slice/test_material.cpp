@@ -370,6 +370,10 @@ TEST_CASE("material mapper: a palette lacking the colour materials is refused fo
   check_message(error_of([&] { MaterialMapper(p, {"r", "g", "b"}); }),
                 {"palette \"no-black\"", "r, g, b need the materials", "lacks VeroBlack", "expected a palette holding them",
                  "rgb_materials"});
+  // With the palette's file as its source, the message starts with the file (the slice and VDB jobs).
+  const std::string with_file = error_of([&] { MaterialMapper(p, {"r", "g", "b"}, "palettes/no-black.json"); });
+  CHECK(with_file.starts_with("palettes/no-black.json: palette \"no-black\""));
+  CHECK_NOTHROW(MaterialMapper(p, {"UltraClear"}, "palettes/no-black.json"));
   p.default_material = 7;
   check_message(error_of([&] { MaterialMapper(p, {}); }), {"default material index 7", "expected"});
   check_message(error_of([&] { MaterialMapper(Palette{}, {}); }), {"0 materials", "expected 1 to 254"});

@@ -101,6 +101,8 @@ public:
   /// @throws trivox::Error (bad_input) when the model has properties r, g and b but the palette
   ///         lacks one of the five colour materials (Palette::rgb_materials)
   MaterialMapper(const Palette& palette, const std::vector<std::string>& property_names);
+  /// The same, its errors prefixed by `source` (the palette's file) unless that is empty.
+  MaterialMapper(const Palette& palette, const std::vector<std::string>& property_names, const std::string& source);
 
   /// Palette size: the length of a fraction vector.
   int materials() const noexcept { return materials_; }
