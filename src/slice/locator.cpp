@@ -1180,8 +1180,7 @@ CellPieces cell_pieces(const vmodel::VCell& vc) {
     cp.cell.lo[dd] = s.domain(d)[0];
     cp.cell.hi[dd] = s.domain(d)[1];
   }
-  cp.bezier = s;
-  for (int d = 0; d < 3; ++d) cp.bezier = spline::to_bezier_form(cp.bezier, d);
+  cp.bezier = spline::to_bezier_form(s);
   for (std::size_t d = 0; d < 3; ++d) {
     for (const auto& br : cp.bezier.knots(static_cast<int>(d)).breakpoints()) cp.breaks[d].push_back(br.value);
     cp.spans[d] = static_cast<int>(cp.breaks[d].size()) - 1;

@@ -75,7 +75,7 @@ std::array<std::vector<double>, 2> bounding_box(const TensorSpline<P>& s, int co
     for (int r = 0; r < s.size(); ++r) std::copy_n(s.point(r).data(), k, pts.data() + static_cast<std::ptrdiff_t>(r) * k);
     return TensorSpline<P>(s.knot_vectors(), k, std::move(pts), s.weights());
   }();
-  for (int d = 0; d < P; ++d) b = to_bezier_form(b, d);
+  b = to_bezier_form(b);
   std::array<int, P> spans{}, orders = b.orders();
   int total = 1;
   for (int d = 0; d < P; ++d) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "tensor_ops.hpp"
@@ -239,24 +240,50 @@ TensorSpline<P> clamp(const TensorSpline<P>& s) {
   return out;
 }
 
-template <int P>
-TensorSpline<P> to_bezier_form(const TensorSpline<P>& s, int dir) {
-  check_dir(s, dir);
-  const KnotVector& kv = s.knots(dir);
+namespace {
+/// The map of to_bezier_form(s, dir) along a knot vector; nullopt where it is the identity
+/// (a clamped vector with every knot at full multiplicity).
+std::optional<Map1D> bezier_map(const KnotVector& kv) {
   const Map1D c = clamp_map(kv);
   std::vector<double> add;
   for (const auto& b : c.to.breakpoints())
     for (int r = b.multiplicity; r < kv.order(); ++r) add.push_back(b.value);
-  // Already in Bezier form along dir (a clamped vector with every knot at full multiplicity): the
-  // map is the identity, and applying it would only copy the net, twice.
-  if (add.empty() && kv.clamped()) return s;
-  return apply_map(s, dir, insert_into(c, std::move(add)));
+  if (add.empty() && kv.clamped()) return std::nullopt;
+  return insert_into(c, std::move(add));
+}
+}  // namespace
+
+template <int P>
+TensorSpline<P> to_bezier_form(const TensorSpline<P>& s, int dir) {
+  check_dir(s, dir);
+  // Already in Bezier form along dir: applying the identity would only copy the net, twice.
+  const auto m = bezier_map(s.knots(dir));
+  return m ? apply_map(s, dir, *m) : s;
+}
+
+template <int P>
+TensorSpline<P> to_bezier_form(const TensorSpline<P>& s) {
+  if (s.rational()) {  // each direction's homogeneous round trip kept: the same floats as before
+    TensorSpline<P> b = s;
+    for (int d = 0; d < P; ++d) b = to_bezier_form(b, d);
+    return b;
+  }
+  // One net through the P maps: the same sums as direction by direction (a polynomial net is
+  // the points themselves), without a copy of the net and a spline per direction.
+  std::optional<detail::Net<P>> net;
+  auto knots = s.knot_vectors();
+  for (int d = 0; d < P; ++d) {
+    const auto m = bezier_map(s.knots(d));
+    if (!m) continue;
+    net = detail::apply_along(net ? *net : detail::to_net(s), d, m->T);
+    knots[static_cast<std::size_t>(d)] = m->to;
+  }
+  return net ? detail::from_net<P>(std::move(knots), s.dim(), false, std::move(*net)) : s;
 }
 
 template <int P>
 std::vector<TensorSpline<P>> bezier_pieces(const TensorSpline<P>& s) {
-  TensorSpline<P> b = s;
-  for (int d = 0; d < P; ++d) b = to_bezier_form(b, d);
+  const TensorSpline<P> b = to_bezier_form(s);
   // In Bezier form the pieces are disjoint blocks of the control net.
   std::array<std::vector<double>, P> breaks;
   std::array<int, P> spans{};
@@ -397,6 +424,7 @@ std::pair<TensorSpline<P>, TensorSpline<P>> make_compatible(const TensorSpline<P
   template TensorSpline<P> clamp(const TensorSpline<P>&, int);                                            \
   template TensorSpline<P> clamp(const TensorSpline<P>&);                                                 \
   template TensorSpline<P> to_bezier_form(const TensorSpline<P>&, int);                                   \
+  template TensorSpline<P> to_bezier_form(const TensorSpline<P>&);                                        \
   template std::vector<TensorSpline<P>> bezier_pieces(const TensorSpline<P>&);                            \
   template std::pair<TensorSpline<P>, TensorSpline<P>> split(const TensorSpline<P>&, int, double);        \
   template TensorSpline<P> restrict_to(const TensorSpline<P>&, int, double, double);                      \

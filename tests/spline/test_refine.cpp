@@ -127,6 +127,26 @@ TEST_CASE("Bezier pieces tile the domain and equal the spline on each piece") {
   }
 }
 
+TEST_CASE("the Bezier form in every direction at once is the form direction by direction") {
+  for (bool rational : {false, true}) {
+    const Trivariate s = random_trivariate(rational, 310);
+    Trivariate by_dir = s;
+    for (int d = 0; d < 3; ++d) by_dir = to_bezier_form(by_dir, d);
+    const Trivariate all = to_bezier_form(s);
+    // The same knots, points and weights, bit for bit (the sums are the same, in the same order).
+    for (int d = 0; d < 3; ++d) CHECK(all.knots(d).knots() == by_dir.knots(d).knots());
+    REQUIRE(all.size() == by_dir.size());
+    bool same_bits = all.weights() == by_dir.weights();
+    for (int r = 0; r < all.size(); ++r)
+      for (int h = 0; h < all.dim(); ++h) same_bits = same_bits && all.point(r)[h] == by_dir.point(r)[h];
+    CHECK(same_bits);
+    // And the function is unchanged: every knot at full multiplicity.
+    CHECK(deviation(all, s, same) < 1e-12);
+    for (int d = 0; d < 3; ++d)
+      for (const auto& br : all.knots(d).breakpoints()) CHECK(br.multiplicity == all.knots(d).order());
+  }
+}
+
 TEST_CASE("splitting and restriction give the function on the sub-domains") {
   for (bool rational : {false, true}) {
     const Trivariate s = random_trivariate(rational, 400);

@@ -46,6 +46,10 @@ TensorSpline<P> clamp(const TensorSpline<P>& s);
 /// control points are its Bezier points).
 template <int P>
 TensorSpline<P> to_bezier_form(const TensorSpline<P>& s, int dir);
+/// to_bezier_form in every direction; a polynomial net goes through the P maps once (the
+/// same floats as direction by direction, without a copy of the net per direction).
+template <int P>
+TensorSpline<P> to_bezier_form(const TensorSpline<P>& s);
 
 /// The Bezier elements of s, one per non-empty tensor span (u fastest, then v, then w), each on
 /// its own sub-domain with Bezier knot vectors.
