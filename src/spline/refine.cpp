@@ -275,7 +275,8 @@ TensorSpline<P> to_bezier_form(const TensorSpline<P>& s) {
   for (int d = 0; d < P; ++d) {
     const auto m = bezier_map(s.knots(d));
     if (!m) continue;
-    net = detail::apply_along(net ? *net : detail::to_net(s), d, m->T);
+    // (Not `net ? *net : to_net(s)`: that conditional is a prvalue, a copy of *net.)
+    net = net ? detail::apply_along(*net, d, m->T) : detail::apply_along(detail::to_net(s), d, m->T);
     knots[static_cast<std::size_t>(d)] = m->to;
   }
   return net ? detail::from_net<P>(std::move(knots), s.dim(), false, std::move(*net)) : s;
