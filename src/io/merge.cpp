@@ -169,9 +169,7 @@ MergeSummary merge_job(const fs::path& dir) {
     merged.files.push_back({"config", "ConfigFile.xml", sha256_hex(config)});
     const auto zip_opt = job.options.find("png.zip");
     if (zip_opt != job.options.end() && zip_opt->second == "yes") {
-      fs::path zip = dir;
-      if (!zip.has_filename()) zip = zip.parent_path();
-      zip += ".gcvf";
+      const fs::path zip = gcvf_path(dir);
       zip_stack(dir, zip);
       merged.files.push_back({"zip", "../" + zip.filename().string(), sha256_file(zip)});
     }

@@ -19,9 +19,9 @@
 #include <time.h>
 
 #include "png_codec.hpp"
+#include "png_rows.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
-#include "png_rows.hpp"
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_stack.hpp"
 #include "trivox/version.hpp"
@@ -103,17 +103,6 @@ struct LayerOut {
   std::string sha256;  ///< of png
 };
 
-}  // namespace
-
-namespace {
-
-/// Where --zip packs the folder: DIR.gcvf beside it.
-fs::path zip_path(const fs::path& dir) {
-  fs::path zip = dir;
-  if (!zip.has_filename()) zip = zip.parent_path();
-  zip += ".gcvf";
-  return zip;
-}
 
 /// What --force (without --resume) removes before a job writes anything, so that the folder ends
 /// up holding this job alone and never looks complete while it does not: ConfigFile.xml first (a
@@ -124,9 +113,8 @@ fs::path zip_path(const fs::path& dir) {
 /// on a journalling disk, for a folder that already says it is unfinished. Sibling shards share
 /// the folder: only the last removes slices past the end, and none removes a manifest of the
 /// same job, so none removes another's work. Files that trivox does not write stay.
-/// @param stale  the manifests in `dir` to remove, with the files they list
-void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vector<Manifest>& stale,
-                       const std::vector<std::string>& stale_names) {
+/// @param stale  the manifests in `dir` to remove (file name, content), with the files they list
+void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vector<std::pair<std::string, Manifest>>& stale) {
   const auto remove = [&](const fs::path& p) {
     std::error_code ec;
     fs::remove(p, ec);
@@ -134,10 +122,10 @@ void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vecto
                         "); expected a folder that --force may overwrite");
   };
   remove(dir / "ConfigFile.xml");
-  for (std::size_t i = 0; i < stale.size(); ++i) {
-    for (const ManifestFile& f : stale[i].files)
+  for (const auto& [name, m] : stale) {
+    for (const ManifestFile& f : m.files)
       if (!f.file.empty() && f.file.find('/') == std::string::npos && f.file != "." && f.file != "..") remove(dir / f.file);
-    remove(dir / stale_names[i]);
+    remove(dir / name);
   }
   const bool png = id.options.count("png") == 0 || id.options.at("png") != "no";
   const bool last = id.shard.index == id.shard.count - 1;
@@ -155,8 +143,7 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
     if (!fs::is_directory(dir, ec))
       throw Error(dir.string() + ": exists and is not a folder; expected a new or empty folder for the slices");
     bool empty = true, same_job_there = false;
-    std::vector<Manifest> stale;  // other jobs' manifests, which --force removes
-    std::vector<std::string> stale_names;
+    std::vector<std::pair<std::string, Manifest>> stale;  // manifests that --force removes
     for (const auto& entry : fs::directory_iterator(dir, ec)) {
       const std::string name = entry.path().filename().string();
       if (name.starts_with(".trivox-write-test")) continue;
@@ -168,8 +155,7 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
           throw Error(dir.string() + ": holds another job (" + name + ": " + why +
                       "); expected the same model and options to resume or add shards (or --force to overwrite, or "
                       "another folder)");
-        stale.push_back(*m);
-        stale_names.push_back(name);
+        stale.emplace_back(name, *m);
         continue;
       }
       same_job_there = true;
@@ -177,15 +163,14 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
       // Without --resume this job's own manifest is superseded, and with --force a whole job's
       // supersedes a sharded run's parts.
       if (force && !resume && (name == id.shard.manifest_name() || id.shard.count == 1)) {
-        stale.push_back(*m);
-        stale_names.push_back(name);
+        stale.emplace_back(name, *m);
       }
     }
     if (!empty && !force && !resume && id.shard.count == 1)
       throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (" +
                   (same_job_there ? std::string("--resume to continue (or verify) the job there, ") : std::string()) +
                   "or --force to overwrite)");
-    if (!empty && force && !resume) clear_earlier_job(dir, id, stale, stale_names);
+    if (!empty && force && !resume) clear_earlier_job(dir, id, stale);
   } else if ((!fs::create_directories(dir, ec) || ec) && !fs::is_directory(dir)) {  // a sibling shard may win
     throw Error(dir.string() + ": cannot create the folder (" + ec.message() + "); expected a writable location");
   }
@@ -293,7 +278,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   manifest.layer_range = opt.shard.range(nz);
   // The archive's place is checked before the slices are written, not after.
   if (opt.zip) {
-    const fs::path zip = zip_path(opt.out_dir);
+    const fs::path zip = gcvf_path(opt.out_dir);
     std::error_code ec;
     if (fs::is_directory(zip, ec))
       throw Error(zip.string() + ": is a folder; expected a .gcvf file path to write (--zip packs DIR as DIR.gcvf)");
@@ -553,7 +538,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     write_file_atomically(opt.out_dir / "ConfigFile.xml", config);
     manifest.files.push_back({"config", "ConfigFile.xml", sha256_hex(config)});
     if (opt.zip) {
-      const fs::path zip = zip_path(opt.out_dir);
+      const fs::path zip = gcvf_path(opt.out_dir);
       zip_stack(opt.out_dir, zip);
       sum.zip_file = zip;
       manifest.files.push_back({"zip", "../" + zip.filename().string(), sha256_file(zip)});

@@ -771,6 +771,13 @@ std::time_t dos_epoch() {
 
 }  // namespace
 
+fs::path gcvf_path(const fs::path& dir) {
+  fs::path zip = dir;
+  if (!zip.has_filename()) zip = zip.parent_path();
+  zip += ".gcvf";
+  return zip;
+}
+
 void zip_stack(const fs::path& dir, const fs::path& gcvf) {
   const StackConfig c = read_stack_config(dir);
   const auto files = detail::list_slices(dir, c.prefix);

@@ -156,6 +156,10 @@ void write_stack_config(const std::filesystem::path& dir, const StackConfig& con
 ///         slice, or an unwritable target; (failed) when libzip reports an error
 void zip_stack(const std::filesystem::path& dir, const std::filesystem::path& gcvf);
 
+/// Where `trivox slice --zip` (and `trivox merge` of such a job) packs the folder `dir`:
+/// `DIR.gcvf` beside it (a trailing '/' of `dir` ignored).
+std::filesystem::path gcvf_path(const std::filesystem::path& dir);
+
 /// One missing or corrupt slice.
 struct SliceProblem {
   int index = 0;        ///< the slice's number as in its file name (start_index + position)
