@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes models/fillet_spheres.json: the two tri-cubic spheres of Masalha, Cirillo & Elber 2021
-(seed 000), Fig. 13, each with its own rgb field, and the fillet operation between them.
+(Fig. 13), each with its own rgb field, and the fillet operation between them.
 
 Each sphere is one tricubic Bezier cell: the 4 x 4 x 4 control points of the cube [-1, 1]^3 at
 uniform parameters, pushed radially onto spheres (g |g|_inf / |g|_2), scaled by the radius. Its

@@ -1,8 +1,8 @@
-// `trivox build SCENE -o MODEL`: expands a scene's primitives (seed 003 Sec. 3.2.3) and fields
+// `trivox build SCENE -o MODEL`: expands a scene's primitives (Massarwi & Elber 2016, Sec. 3.2.3) and fields
 // into a model, writes it atomically (save_model: a temporary name, then a rename), and prints a
 // quality report: per cell the Jacobian validity bounds and the volume, per primitive the exact
 // volume against the cells' total and how closely the properties follow the field, per fillet
-// (ruled, seed 000 Alg. 2, VBS, Sec. 3.2 / Alg. 3, or V-rep, Sec. 5 / Alg. 6) its gap, C0 glue
+// (ruled, Masalha et al. 2021, Alg. 2, VBS, Sec. 3.2 / Alg. 3, or V-rep, Sec. 5 / Alg. 6) its gap, C0 glue
 // between its cells, G1 angle, sampled det J sign and property jump (fillet/fillet.hpp). Exit 1 when a cell is not
 // valid (the model is written all the same, so it can be inspected).
 #include <tbb/parallel_for.h>
@@ -17,7 +17,7 @@
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/geom/validity.hpp"
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/scene.hpp"
+#include "trivox/scene/scene.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/slice/trim.hpp"
 
@@ -32,11 +32,11 @@ struct Options {
 
 struct CellQuality {
   bool checked = false;  ///< false for a rational trivariate, which check_validity does not decide
-  /// A fillet's half: det J vanishes on the faces that collapse onto the rails (seed 000 Sec. 9),
+  /// A fillet's half: det J vanishes on the faces that collapse onto the rails (Masalha et al. 2021, Sec. 9),
   /// so its verdict is the sign of det J inside, from the fillet's own report.
   const fillet::FilletQuality* fillet = nullptr;
   std::size_t fillet_cell = 0;  ///< its index among the fillet's cells (FilletQuality::cell_jacobian)
-  /// A bridging fillet's half (seed 000 Sec. 6.1): singular on the edge by construction, judged
+  /// A bridging fillet's half (Masalha et al. 2021, Sec. 6.1): singular on the edge by construction, judged
   /// the same way from its own report.
   const fillet::CornerQuality* corner = nullptr;
   geom::ValidityReport<3> validity;
@@ -45,7 +45,7 @@ struct CellQuality {
 
 /// A Shepard fillet's encoding fit (fillet/shepard.hpp) for component k: its two cells, a then b;
 /// null for parametric fillets.
-nlohmann::ordered_json shepard_fit(const io::FilletBuild& f, std::size_t k) {
+nlohmann::ordered_json shepard_fit(const scene::FilletBuild& f, std::size_t k) {
   if (f.shepard.size() < 2 * (k + 1)) return nullptr;
   nlohmann::ordered_json out = nlohmann::ordered_json::array();
   for (std::size_t h = 0; h < 2; ++h) {
@@ -57,7 +57,7 @@ nlohmann::ordered_json shepard_fit(const io::FilletBuild& f, std::size_t k) {
 }
 
 /// The scene's derived surfaces (G+Smo patches merged, offsets: construct/patches.hpp).
-nlohmann::ordered_json scene_surfaces(const io::SceneBuild& built) {
+nlohmann::ordered_json scene_surfaces(const scene::SceneBuild& built) {
   nlohmann::ordered_json out = nlohmann::ordered_json::array();
   for (const auto& s : built.surfaces) {
     nlohmann::ordered_json o{{"name", s.name}, {"kind", s.kind}, {"orders", s.orders}, {"counts", s.counts}};
@@ -71,8 +71,8 @@ nlohmann::ordered_json scene_surfaces(const io::SceneBuild& built) {
   return out;
 }
 
-/// The constructor operations (seed 003 Sec. 3.2.2; construct/tube_solid.hpp for tubes).
-nlohmann::ordered_json constructs(const io::SceneBuild& built) {
+/// The constructor operations (Massarwi & Elber 2016, Sec. 3.2.2; construct/tube_solid.hpp for tubes).
+nlohmann::ordered_json constructs(const scene::SceneBuild& built) {
   nlohmann::ordered_json out = nlohmann::ordered_json::array();
   for (const auto& c : built.constructs) {
     nlohmann::ordered_json field = nullptr;
@@ -84,7 +84,7 @@ nlohmann::ordered_json constructs(const io::SceneBuild& built) {
   return out;
 }
 
-nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<CellQuality>& q, const Options& opt) {
+nlohmann::ordered_json report(const scene::SceneBuild& built, const std::vector<CellQuality>& q, const Options& opt) {
   const auto& cells = built.model.cells;
   std::vector<std::string> source(cells.size());
   for (const auto& p : built.primitives)
@@ -208,7 +208,7 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                   {"min_jacobian", b.quality.det_min},
                   {"max_jacobian", b.quality.det_max},
                   {"seconds", b.seconds}});
-  // Fillets over several faces (seed 000 Sec. 6.1): the bridging fillets at convex corners.
+  // Fillets over several faces (Masalha et al. 2021, Sec. 6.1): the bridging fillets at convex corners.
   nlohmann::ordered_json jk = nlohmann::ordered_json::array();
   for (const auto& c : built.corners) {
     const auto& q2 = c.quality;
@@ -247,7 +247,7 @@ nlohmann::ordered_json report(const io::SceneBuild& built, const std::vector<Cel
                            {"glue_before", q2.seam_glue_before},
                            {"property_jump", q2.seam_property_jump}};
   }
-  // Concave corners (seed 000 Sec. 6): the pieces clipped at the rails' crossing and stitched.
+  // Concave corners (Masalha et al. 2021, Sec. 6): the pieces clipped at the rails' crossing and stitched.
   nlohmann::ordered_json js = nlohmann::ordered_json::array();
   for (const auto& st : built.stitches) {
     const auto& jn = st.junction;
@@ -328,7 +328,7 @@ void print_human(const nlohmann::ordered_json& j) {
                   f["jacobian"].get<std::string>().c_str(), c0 && c1 ? "composed" : (c0 || c1 ? "mixed" : "fitted"),
                   fmt(f["seconds"].get<double>(), 3).c_str());
     }
-    // V-rep fillets (seed 000 Alg. 6): the trimmed cell is T_hbs less the solid beyond S_b.
+    // V-rep fillets (Masalha et al. 2021, Alg. 6): the trimmed cell is T_hbs less the solid beyond S_b.
     for (const auto& f : j["fillets"]) {
       if (f["vrep"].is_null()) continue;
       const auto& v = f["vrep"];
@@ -429,8 +429,8 @@ void add_build(CLI::App& app, Common& common) {
     std::error_code ec;
     if (!opt->force && std::filesystem::exists(opt->output, ec))
       throw Error(opt->output + ": the file exists; expected a new model file name, or --force to replace it");
-    const io::Scene scene = io::load_scene(opt->scene);
-    const io::SceneBuild built = io::build_scene(scene);
+    const scene::Scene scene = scene::load_scene(opt->scene);
+    const scene::SceneBuild built = scene::build_scene(scene);
     // Each cell's geometry: a primitive's before its field refined it (the same map).
     std::vector<const spline::Trivariate*> geometry;
     for (const auto& c : built.model.cells) geometry.push_back(&c.volume);

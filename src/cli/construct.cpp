@@ -1,5 +1,5 @@
 // `trivox construct INPUT`: one constructor (Boolean sum, half Boolean sum, ruling, extrusion,
-// revolution, sweep) on given curves or surfaces, regular or kernel-based (seed 004, Alg. 1),
+// revolution, sweep) on given curves or surfaces, regular or kernel-based (Fadila et al. 2023, Alg. 1),
 // with its Jacobian validity. Exit 1 when the result is not a valid parametrisation (then -o
 // writes nothing unless --keep-invalid).
 #include <algorithm>
@@ -65,7 +65,7 @@ Verdict verdict_of(const spline::Trivariate& t) {
   return {true, r.verdict == geom::Validity::valid, r.min_bound, r.max_bound};
 }
 
-/// Planar boundary curves must meet only at their shared ends (seed 004 Sec. 4: input
+/// Planar boundary curves must meet only at their shared ends (Fadila et al. 2023, Sec. 4: input
 /// "intersection and self-intersection free"), checked to 1e-5 of their extent.
 void check_simple(const io::ConstructInput& in, const std::string& file) {
   if (in.curves.empty() || in.op == "extrude" || in.op == "revolve" || in.op == "sweep") return;
@@ -168,7 +168,7 @@ void run(const Options& opt, const io::ConstructInput& in, Common& common) {
   } else {
     if (in.op != "boolean_sum" && in.op != "half_boolean_sum" && in.op != "ruled")
       throw Error(opt.input + ": /op: \"" + in.op + "\" with --kernel; expected boolean_sum, half_boolean_sum or ruled "
-                  "(the kernel-based constructors of seed 004)");
+                  "(the kernel-based constructors of Fadila et al. 2023)");
     construct::KernelConstructOptions ko;
     if (opt.add_dof == "refine") ko.add_dof = construct::AddDof::refine;
     else if (opt.add_dof == "elevate") ko.add_dof = construct::AddDof::elevate;
@@ -272,13 +272,13 @@ void add_construct(CLI::App& app, Common& common) {
   sub->add_option("INPUT", opt->input, "Constructor input (.json: op, curves or surfaces)")->required();
   sub->add_option("-o,--output", opt->output, "Write the result (.json: surfaces or trivariates)");
   sub->add_flag("--force", opt->force, "Overwrite an existing output file");
-  sub->add_flag("--kernel", opt->kernel, "Kernel-based construction (seed 004, Alg. 1) when the regular one is invalid");
+  sub->add_flag("--kernel", opt->kernel, "Kernel-based construction (Fadila et al. 2023, Alg. 1) when the regular one is invalid");
   sub->add_option("--add-dof", opt->add_dof, "How --kernel adds freedom: refine (knots per span) or elevate (degree)")
       ->check(CLI::IsMember({"refine", "elevate"}));
   sub->add_option("--max-dof", opt->max_dof, "Largest number of knots per span or degree raisings tried (0..64)")
       ->check(CLI::Range(0, 64));
   sub->add_option("--spread", opt->spread,
-                  "Seed 004 Sec. 6: spread interior points on a grid this fraction of the kernel's size (0..1)")
+                  "Fadila et al. 2023, Sec. 6: spread interior points on a grid this fraction of the kernel's size (0..1)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_flag("--strict", opt->strict, "With --kernel, accept only det J > 0 everywhere (not just >= 0)");
   sub->add_flag("--keep-invalid", opt->keep_invalid, "Write the output even when the result is not valid");

@@ -58,10 +58,10 @@ void add_locate(CLI::App& app, Common& common) {
       std::copy(v.begin() + 3, v.end(), props.begin());
       // A Boolean's intersection cell blends its inputs' properties (VCell::blend).
       if (!props.empty()) locator.admits(r.cell, q, props.data());
-      // A Shepard fillet cell: f itself (seed 000 Sec. 7.2), cold closest points.
+      // A Shepard fillet cell: f itself (Masalha et al. 2021, Sec. 7.2), cold closest points.
       const auto& sd = model.cells[static_cast<std::size_t>(r.cell)].shepard;
       if (blend == slice::PropertyBlend::shepard && sd && !props.empty()) {
-        const auto v = fillet::ShepardField(*sd).eval(q, props.data());
+        const auto v = vmodel::ShepardField(*sd).eval(q, props.data());
         j["shepard"] = {{"alpha", v.alpha}, {"distance", v.distance}};
       }
       j["cell"] = model.cells[static_cast<std::size_t>(r.cell)].name;

@@ -1,4 +1,4 @@
-// The trivox executable: a thin command line over the library. Exit codes (DESIGN.md): 0 success,
+// The trivox executable: a thin command line over the library. Exit codes (docs/architecture.md): 0 success,
 // 1 the operation failed on valid input, 2 bad usage or bad input. Every exception is caught
 // here, so no input ends in a crash.
 #include <cstdio>
@@ -12,7 +12,7 @@
 
 namespace {
 
-/// CLI11's parse errors in trivox's words (DESIGN.md: the place, what was found, what was
+/// CLI11's parse errors in trivox's words (docs/architecture.md: the place, what was found, what was
 /// expected): "--layer abc: not a number; expected a number: <the option's help>".
 std::string usage_message(const CLI::App& app, const CLI::ParseError& e, const char* first_arg) {
   const auto subs = app.get_subcommands();

@@ -6,7 +6,7 @@
 
 #include "common.hpp"
 #include "trivox/error.hpp"
-#include "trivox/io/merge.hpp"
+#include "trivox/job/merge.hpp"
 
 namespace trivox::cli {
 
@@ -33,7 +33,7 @@ void add_merge(CLI::App& app, Common& common) {
     if (opt->threads > 0)
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     static_cast<std::size_t>(opt->threads));
-    const io::MergeSummary s = io::merge_job(opt->dir);
+    const job::MergeSummary s = job::merge_job(opt->dir);
     if (common.json) {
       nlohmann::ordered_json mats = nlohmann::ordered_json::object();
       for (std::size_t m = 0; m < s.materials.size(); ++m) mats[s.materials[m]] = s.material_voxels[m];

@@ -11,11 +11,11 @@
 
 #include "common.hpp"
 #include "trivox/error.hpp"
-#include "trivox/io/manifest.hpp"
+#include "trivox/job/manifest.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/sha256.hpp"
-#include "trivox/io/slice_job.hpp"
-#include "trivox/io/vdb_job.hpp"
+#include "trivox/job/slice_job.hpp"
+#include "trivox/job/vdb_job.hpp"
 #include "trivox/version.hpp"
 
 namespace trivox::cli {
@@ -47,7 +47,7 @@ std::string duration(double s) {
 /// Progress on stderr: a bar redrawn in place on a terminal, a line every 5 s otherwise.
 /// @param unit  what is counted ("layers"; "blocks" for the VDB's 8-layer blocks)
 /// @param what  what per second ("voxels"; "samples")
-io::SliceProgress make_progress(const std::string& mode, const char* unit = "layers", const char* what = "voxels") {
+job::SliceProgress make_progress(const std::string& mode, const char* unit = "layers", const char* what = "voxels") {
   if (mode == "never") return {};
   const bool bar = mode == "bar" || (mode == "auto" && isatty(STDERR_FILENO));
   // The rate and the ETA are measured from the first report on: the time before it holds the
@@ -94,7 +94,7 @@ std::string human_bytes(double b) {
   return buf;
 }
 
-nlohmann::ordered_json vdb_json(const io::VdbJobSummary& v) {
+nlohmann::ordered_json vdb_json(const job::VdbJobSummary& v) {
   nlohmann::ordered_json mats = nlohmann::ordered_json::array();
   for (std::size_t m = 0; m < v.materials.size(); ++m)
     mats.push_back({{"name", v.materials[m]}, {"volume_mm3", v.material_volume_mm3[m]}});
@@ -118,7 +118,7 @@ nlohmann::ordered_json vdb_json(const io::VdbJobSummary& v) {
           {"seconds", v.seconds}};
 }
 
-void print_vdb(const io::VdbJobSummary& v) {
+void print_vdb(const job::VdbJobSummary& v) {
   const auto& p = v.plan;
   std::string grids;
   for (const auto& g : v.grids) grids += (grids.empty() ? "" : ", ") + g;
@@ -187,9 +187,9 @@ void add_slice(CLI::App& app, Common& common) {
     if (opt->threads < 0 || opt->threads > 1024)
       throw Error("--threads " + std::to_string(opt->threads) + ": out of range; expected 1 to 1024 (0: all cores)");
     // The shard: --shard wins over a scheduler's environment (Slurm arrays, Kubernetes).
-    io::Shard shard;
-    if (!opt->shard.empty()) shard = io::parse_shard(opt->shard);
-    else if (const auto env = io::shard_from_environment(sub->count("--shard-count") ? std::optional<int>(opt->shard_count) : std::nullopt))
+    job::Shard shard;
+    if (!opt->shard.empty()) shard = job::parse_shard(opt->shard);
+    else if (const auto env = job::shard_from_environment(sub->count("--shard-count") ? std::optional<int>(opt->shard_count) : std::nullopt))
       shard = *env;
     else if (sub->count("--shard-count"))
       throw Error("--shard-count " + std::to_string(opt->shard_count) +
@@ -198,9 +198,9 @@ void add_slice(CLI::App& app, Common& common) {
     if (!slice::property_blend_from_name(opt->blend, sampling.blend))
       throw Error("--blend " + opt->blend + ": unknown; expected encoded or shepard");
     const auto model = io::load_model(opt->model);
-    io::VdbJobOptions vj;
+    job::VdbJobOptions vj;
     vj.sampler = sampling;
-    std::optional<io::VdbPlan> plan;
+    std::optional<job::VdbPlan> plan;
     if (want_vdb) {
       vj.out_dir = opt->out;
       vj.model_file = opt->model;
@@ -209,14 +209,14 @@ void add_slice(CLI::App& app, Common& common) {
       vj.supersample = opt->supersample;
       vj.force = opt->force;
       vj.require_empty_folder = !want_png;
-      plan = io::plan_vdb_job(model, vj);  // bad VDB options fail before the PNG stack is written
+      plan = job::plan_vdb_job(model, vj);  // bad VDB options fail before the PNG stack is written
       // The later plans, and the PNG job, reuse its measures of the model.
       vj.model_box = plan->model_box;
       vj.model_volume_mm3 = plan->estimated_volume_mm3;
       if (shard.count > 1) {  // this shard's whole leaves, in a part of its own
         vj.layer_range = shard.range(plan->count[2]);
         vj.file_name = shard.part_name(plan->file.filename().string());
-        plan = io::plan_vdb_job(model, vj);
+        plan = job::plan_vdb_job(model, vj);
       }
     }
     std::unique_ptr<tbb::global_control> limit;
@@ -228,15 +228,15 @@ void add_slice(CLI::App& app, Common& common) {
     // Part of the job's identity only when not the default, so earlier manifests still resume.
     if (sampling.blend != slice::PropertyBlend::encoded) vdb_options["blend"] = slice::property_blend_name(sampling.blend);
     if (plan) {
-      vdb_options["vdb.voxel_mm"] = io::option_number(plan->voxel_mm);
+      vdb_options["vdb.voxel_mm"] = job::option_number(plan->voxel_mm);
       vdb_options["vdb.supersample"] = std::to_string(plan->supersample);
     }
     const std::string model_sha = io::sha256_file(opt->model);
     vj.model_sha256 = model_sha;  // the VDB's metadata: hashed once
     // A resumed job keeps its VDB when the manifest lists it and it verifies.
-    auto verified_vdb = [&]() -> std::optional<io::ManifestFile> {
+    auto verified_vdb = [&]() -> std::optional<job::ManifestFile> {
       if (want_vdb && opt->resume)
-        if (const auto m = io::read_manifest(opt->out, shard.manifest_name()))
+        if (const auto m = job::read_manifest(opt->out, shard.manifest_name()))
           for (const auto& f : m->files)
             if (f.role == "vdb" && f.file == plan->file.filename().string() &&
                 std::filesystem::is_regular_file(plan->file) && io::sha256_file(plan->file) == f.sha256)
@@ -245,7 +245,7 @@ void add_slice(CLI::App& app, Common& common) {
     };
     if (!want_png) {
       // A volume-only job: its manifest lists the VDB (a shard's: its part of whole leaves).
-      io::Manifest id;
+      job::Manifest id;
       id.trivox = version;
       id.model_file = opt->model;
       id.model_sha256 = model_sha;
@@ -256,15 +256,15 @@ void add_slice(CLI::App& app, Common& common) {
       id.grid = plan->count;
       id.shard = shard;
       id.layer_range = shard.range(plan->count[2]);
-      const auto previous = io::prepare_job_folder(opt->out, id, opt->force, opt->resume);
+      const auto previous = job::prepare_job_folder(opt->out, id, opt->force, opt->resume);
       const auto kept = previous ? verified_vdb() : std::nullopt;
-      std::optional<io::VdbJobSummary> v;
+      std::optional<job::VdbJobSummary> v;
       if (!kept) {
-        io::write_file_atomically(std::filesystem::path(opt->out) / shard.manifest_name(), io::manifest_json(id));
+        io::write_file_atomically(std::filesystem::path(opt->out) / shard.manifest_name(), job::manifest_json(id));
         vj.require_empty_folder = false;  // checked above, with the manifest
-        v = io::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
+        v = job::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
       }
-      io::finish_manifest(opt->out, shard, {kept ? *kept : io::ManifestFile{"vdb", v->file.filename().string(), v->sha256}});
+      job::finish_manifest(opt->out, shard, {kept ? *kept : job::ManifestFile{"vdb", v->file.filename().string(), v->sha256}});
       if (common.json) {
         nlohmann::ordered_json j = {{"model", opt->model}, {"output", opt->out}};
         if (v) j["vdb"] = vdb_json(*v);
@@ -281,7 +281,7 @@ void add_slice(CLI::App& app, Common& common) {
                     shard.count, id.layer_range[0], id.layer_range[1] - 1, opt->out.c_str());
       return;
     }
-    io::SliceJobOptions job;
+    job::SliceJobOptions job;
     job.profile = slice::printer_preset(opt->printer);
     if (!opt->dpi.empty()) {
       const auto d = parse_numbers(opt->dpi, 2, "--dpi");
@@ -308,14 +308,14 @@ void add_slice(CLI::App& app, Common& common) {
     job.shard = shard;
     job.sampler = sampling;
     if (plan) job.model_box = plan->model_box;
-    const std::optional<io::ManifestFile> vdb_done = verified_vdb();
-    const auto s = io::run_slice_job(model, job, make_progress(opt->progress));
-    std::optional<io::VdbJobSummary> v;
+    const std::optional<job::ManifestFile> vdb_done = verified_vdb();
+    const auto s = job::run_slice_job(model, job, make_progress(opt->progress));
+    std::optional<job::VdbJobSummary> v;
     if (want_vdb && vdb_done) {
-      io::finish_manifest(opt->out, s.shard, {*vdb_done});
+      job::finish_manifest(opt->out, s.shard, {*vdb_done});
     } else if (want_vdb) {
-      v = io::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
-      io::finish_manifest(opt->out, s.shard, {{"vdb", v->file.filename().string(), v->sha256}});
+      v = job::run_vdb_job(model, vj, make_progress(opt->progress, "blocks", "samples"));
+      job::finish_manifest(opt->out, s.shard, {{"vdb", v->file.filename().string(), v->sha256}});
     }
 
     nlohmann::ordered_json mats = nlohmann::ordered_json::array();

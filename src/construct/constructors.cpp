@@ -465,7 +465,7 @@ Surface half_boolean_sum(const Curve& c1_in, const Curve& c2_in, const MatchOpti
   check_points_match(p1, p2, match, "curve 0 at its start", "curve 1 at its start");
   std::vector<double> P(p1.size());
   for (std::size_t i = 0; i < P.size(); ++i) P[i] = p1[i] == p2[i] ? p1[i] : 0.5 * (p1[i] + p2[i]);
-  // S(u, v) = c1(u) + c2(v) - P: seed 004 Sec. 3.1.
+  // S(u, v) = c1(u) + c2(v) - P: Fadila et al. 2023, Sec. 3.1.
   return spline::add(spline::add(extend_constant<2>(c1, 1), extend_constant<2>(c2, 0)), constant<2>(P), -1.0);
 }
 
@@ -475,7 +475,7 @@ Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const Ma
   const Curve a = spline::iso(s1, 1, 0.0), b = spline::iso(s2, 1, 0.0);
   check_curves_match(a, b, match, "surface 0 at v = 0", "surface 1 at w = 0", "u");
   const Curve C = average(a, b);
-  // T(u, v, w) = s1(u, v) + s2(u, w) - C(u): seed 004 Sec. 3.2, Lemma 2.
+  // T(u, v, w) = s1(u, v) + s2(u, w) - C(u): Fadila et al. 2023, Sec. 3.2, Lemma 2.
   Trivariate T = spline::add(extend_constant<3>(s1, 2), extend_constant<3>(s2, 1));
   return spline::add(T, extend_constant<3>(extend_constant<2>(C, 1), 2), -1.0);
 }
@@ -496,7 +496,7 @@ Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const Su
   std::vector<double> P(p1.size());
   for (std::size_t i = 0; i < P.size(); ++i)
     P[i] = p1[i] == p2[i] && p2[i] == p3[i] ? p1[i] : (p1[i] + p2[i] + p3[i]) / 3.0;
-  // T = s1(u,v) + s2(v,w) + s3(u,w) - (C1(u) + C2(v) + C3(w)) + P: seed 004 Sec. 3.2, Lemma 3.
+  // T = s1(u,v) + s2(v,w) + s3(u,w) - (C1(u) + C2(v) + C3(w)) + P: Fadila et al. 2023, Sec. 3.2, Lemma 3.
   Trivariate T = spline::add(extend_constant<3>(s1, 2), extend_constant<3>(s2, 0));
   T = spline::add(T, extend_constant<3>(s3, 1));
   T = spline::add(T, extend_constant<3>(extend_constant<2>(C1, 1), 2), -1.0);

@@ -218,7 +218,7 @@ void quarter_turns(double& x, double& y, int q) {
   }
 }
 
-/// core, then the outer parts at quarter turns q = 0 (+x), 1 (+y), 2 (-x), 3 (-y) (seed 003
+/// core, then the outer parts at quarter turns q = 0 (+x), 1 (+y), 2 (-x), 3 (-y) (Massarwi & Elber 2016
 /// Fig. 9 (a)): the square [-0.5, 0.5]^2 in the arc's space in both directions, and each outer
 /// part ruled (u) from the square's side to the arc, v counter-clockwise.
 std::array<Patch2, 5> disk_pattern(const Arc& arc) {
@@ -282,7 +282,7 @@ void check(const Cone& c) {
   unit_axis("cone", c.axis);
   need_positive("cone", "radius", c.radius);
   if (c.top_radius == 0.0)
-    throw Error("cone top_radius 0: a cone with an apex is singular there (seed 003 Sec. 3.2.3); expected a "
+    throw Error("cone top_radius 0: a cone with an apex is singular there (Massarwi & Elber 2016, Sec. 3.2.3); expected a "
                 "positive top_radius (a frustum; use a small one for a nearly sharp cone)");
   need_positive("cone", "top_radius", c.top_radius);
   need_positive("cone", "height", c.height);

@@ -169,7 +169,7 @@ CornerFillet bridge_corner(const CornerInput& in, const BlendOptions& blend, dou
   const auto start = std::chrono::steady_clock::now();
   if (in.face == nullptr || in.meet == nullptr) throw Error("fillet corner: no face given");
   if (blend.section != Section::hermite)
-    throw Error("fillet corner: the bridging fillet (seed 000 Sec. 6.1) takes the Hermite section; expected "
+    throw Error("fillet corner: the bridging fillet (Masalha et al. 2021, Sec. 6.1) takes the Hermite section; expected "
                 "\"section\": \"hermite\" with corners");
   if (!(tol > 0.0)) throw Error("fillet corner: tolerance " + num(tol) + "; expected a positive value");
   if (in.face->dim() != in.meet->dim() || in.face->dim() < 3)
@@ -407,7 +407,7 @@ double plane_root(const Surface& f, double v, const Vec& o, const Vec& n, double
   return 0.5 * (a + b);
 }
 
-/// Seed 000 Sec. 6, the concave corner: a ruled fillet half clipped by the stitch plane Pi
+/// Masalha et al. 2021, Sec. 6, the concave corner: a ruled fillet half clipped by the stitch plane Pi
 /// (through o, n its normal): each of its faces w = 0 (on S^_i) and w = 1 (on S_b) becomes
 /// F(u(s, v), v), u running from where F's v-iso crosses Pi (a(v), interpolated at the Greville
 /// points of a cubic space, spans doubled until F(a(v), v) is within tol of Pi) to the far end
@@ -567,7 +567,7 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
   if (!(fo.tolerance > 0.0)) fo.tolerance = 1e-7 * diag;
   if (fo.construction != Construction::ruled)
     throw Error("fillet across faces: construction " + std::string(construction_name(fo.construction)) +
-                "; expected \"ruled\" (seed 000 Sec. 6 here joins ruled fillets, Alg. 2)");
+                "; expected \"ruled\" (Masalha et al. 2021, Sec. 6 here joins ruled fillets, Alg. 2)");
   const double tol = fo.tolerance;
   const double jt = co.join_tolerance > 0.0 ? co.join_tolerance
                                             : std::max(100.0 * tol, 1e-4 * std::min(fo.distance[0], fo.distance[1]));
@@ -636,7 +636,7 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
             if (mate[x][static_cast<std::size_t>(ex)] >= 0)
               throw Error("fillet across faces: three or more pieces of C meet at " +
                           at(pieces[x].ends[static_cast<std::size_t>(ex)].o) + " (" + piece_name(pieces[x], side1, side2) +
-                          " among them); expected a curve C whose pieces meet in pairs (seed 000 Sec. 6)");
+                          " among them); expected a curve C whose pieces meet in pairs (Masalha et al. 2021, Sec. 6)");
           mate[a][static_cast<std::size_t>(ea)] = static_cast<long>(2 * b + static_cast<std::size_t>(eb));
           mate[b][static_cast<std::size_t>(eb)] = static_cast<long>(2 * a + static_cast<std::size_t>(ea));
         }
@@ -718,7 +718,7 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
     if (!meet[0] && !meet[1])
       throw Error(where + ": the rails meet on neither body (gaps " + num(norm(sub(ea.rail[0], eb.rail[0]))) + " and " +
                   num(norm(sub(ea.rail[1], eb.rail[1]))) +
-                  "); expected an edge of one body only, perpendicular to the other body's face there (seed 000 "
+                  "); expected an edge of one body only, perpendicular to the other body's face there (Masalha et al. 2021 "
                   "Sec. 6.1; clipping rails at a slanted edge is not supported)");
     const int g = meet[0] ? 1 : 0;
     const std::size_t gs = static_cast<std::size_t>(g);
@@ -808,7 +808,7 @@ MultiFillet fillet_across(const std::vector<SideFace>& side1, const std::vector<
                   piece_name(*pc[1], side1, side2) + ": the clipped fillets' end sections in the stitch plane through o, the rails' crossing " +
                   at(jn.x) + " and r " + at(jn.r) + " lie " + num(jn.glue_before) +
                   " apart; expected a corner symmetric about that plane (one straight edge, perpendicular to the face, "
-                  "equal angles; seed 000 Sec. 6)");
+                  "equal angles; Masalha et al. 2021, Sec. 6)");
     {
       // The first piece's cells are refined into the common space as well (exactly): a copy,
       // so that its layers stay untouched.

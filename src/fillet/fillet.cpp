@@ -130,7 +130,7 @@ const Trivariate& part(const Fillet& f, std::size_t i) {
 
 Surface face_of(const Fillet& f, const FaceRef& r) { return spline::boundary_face(part(f, r.cell), r.face); }
 
-/// The quality report of seed 000's fillet (see fillet.hpp), for either construction.
+/// The quality report of Masalha et al. 2021's fillet (see fillet.hpp), for either construction.
 void measure(const std::array<const Surface*, 2>& faces, const Surface& blend, const Fillet& f, FilletQuality& q) {
   const Layout l = layout(q.construction, q.construction == Construction::vrep ? q.vrep.v_b : q.vbs.v_b);
   const int k = faces[0]->dim();
@@ -209,7 +209,7 @@ void measure(const std::array<const Surface*, 2>& faces, const Surface& blend, c
   }
   // det J at interior points of every cell: per knot span along C, 6 x 4 (ruled: few w) or
   // 6 x 6 (vbs, vrep: T_hbs untrimmed) across. Sampled, not bounded: check_validity chases the zero rail edges of
-  // thousand-span cells for minutes (seed 000 Sec. 9: det J vanishes on the rails).
+  // thousand-span cells for minutes (Masalha et al. 2021, Sec. 9: det J vanishes on the rails).
   q.det_min = std::numeric_limits<double>::infinity();
   q.det_max = -q.det_min;
   const int n1 = 6, n2 = q.construction == Construction::ruled ? 4 : 6;
@@ -321,7 +321,7 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
     so.method = o.method;  // subregion() composes for `matched` (only the whole curve lands there)
     so.tolerance = tol;
     // The sub-regions and blending inputs: one pair over the whole curve, or, for B-spline faces
-    // whose knot lines C crosses, one matched Bezier pair per piece (seed 000 Alg. 4-5), each
+    // whose knot lines C crosses, one matched Bezier pair per piece (Masalha et al. 2021, Alg. 4-5), each
     // composed exactly; "auto" falls back to fitting (Sec. 4.3) when Lemma 1's condition fails.
     struct Part {
       Surface sub1, sub2;

@@ -172,7 +172,7 @@ std::vector<MatchedCut> matched_cuts(const Surface& face1, const Surface& face2,
       const auto& on_r = x.on_r;
       const std::string line = std::string(cut.dir[ui] == 0 ? "u = " : "v = ") + num(cut.value[ui]);
       if (on_c.size() != on_r.size())
-        throw Error("fillet (seed 000 Alg. 5): face " + std::to_string(i + 1) + "'s cutting line " + line + " crosses C " +
+        throw Error("fillet (Masalha et al. 2021, Alg. 5): face " + std::to_string(i + 1) + "'s cutting line " + line + " crosses C " +
                         std::to_string(on_c.size()) + " times and its rail " + std::to_string(on_r.size()) +
                         " times; expected equal counts (Lemma 1), or method \"fit\" (Sec. 4.3)",
                     ErrorKind::failed);
@@ -185,7 +185,7 @@ std::vector<MatchedCut> matched_cuts(const Surface& face1, const Surface& face2,
     // The rail pieces must follow C's order, without wrapping past the ends.
     for (std::size_t k = 0; k + 1 < merged.size(); ++k)
       if (!(merged[k].rail[ui] < merged[k + 1].rail[ui]))
-        throw Error("fillet (seed 000 Alg. 5): on face " + std::to_string(i + 1) + " the rail crosses the cutting lines at t = " +
+        throw Error("fillet (Masalha et al. 2021, Alg. 5): on face " + std::to_string(i + 1) + " the rail crosses the cutting lines at t = " +
                         num(merged[k].rail[ui]) + " and " + num(merged[k + 1].rail[ui]) +
                         ", out of C's order (t = " + num(merged[k].t) + ", " + num(merged[k + 1].t) +
                         "); expected matched pieces, or method \"fit\" (Sec. 4.3)",
@@ -227,7 +227,7 @@ std::vector<MatchedPiece> matched_pieces(const Surface& face1, const Surface& fa
     const std::vector<Curve> c = construct::common_space<1>(std::span<const Curve>(normal.data(), normal.size()));
     for (std::size_t i = 0; i < 2; ++i)
       if (crosses_knot_lines(*face[i], c[2 * i + 1]) || crosses_knot_lines(*face[i], c[2 * i]))
-        throw Error("fillet (seed 000 Alg. 5): piece " + std::to_string(p + 1) + " of face " + std::to_string(i + 1) +
+        throw Error("fillet (Masalha et al. 2021, Alg. 5): piece " + std::to_string(p + 1) + " of face " + std::to_string(i + 1) +
                         "'s sub-region (C from t = " + num(mp.t[0]) + " to " + num(mp.t[1]) + ", the rail from " +
                         num(mp.rail[i][0]) + " to " + num(mp.rail[i][1]) +
                         ") crosses a knot line of the face; expected one Bezier patch per piece, or method \"fit\" (Sec. 4.3)",
@@ -236,7 +236,7 @@ std::vector<MatchedPiece> matched_pieces(const Surface& face1, const Surface& fa
       mp.sub1 = subregion(face1, c[1], c[0], exact);  // v = 0 on rail 1, v = 1 on C
       mp.sub2 = subregion(face2, c[2], c[3], exact);  // v = 0 on C, v = 1 on rail 2
     } catch (const Error& e) {
-      throw Error("fillet (seed 000 Alg. 5): piece " + std::to_string(p + 1) + ": " + e.what() +
+      throw Error("fillet (Masalha et al. 2021, Alg. 5): piece " + std::to_string(p + 1) + ": " + e.what() +
                       "; method \"fit\" (Sec. 4.3) applies",
                   ErrorKind::failed);
     }

@@ -1291,7 +1291,7 @@ LayerSampler::LayerSampler(const vmodel::VModel& model, const VoxelGrid& grid, S
     if (k == data.size()) {
       data.push_back(&*sd);
       try {
-        shepard_.push_back(std::make_unique<fillet::ShepardField>(*sd));
+        shepard_.push_back(std::make_unique<vmodel::ShepardField>(*sd));
       } catch (const Error& e) {
         throw e.within("cell " + model.cells[c].name);
       }
@@ -1310,7 +1310,7 @@ void LayerSampler::apply_shepard(int layer, int r0, int nr, std::int32_t* owner,
   // is local to the block, so a voxel's value depends only on its block.
   constexpr std::size_t slots = 4;
   const double reach = 8.0 * std::max({grid_.pitch[0], grid_.pitch[1], grid_.pitch[2]});
-  std::vector<std::array<fillet::ShepardWalk, slots>> walks(shepard_.size());
+  std::vector<std::array<vmodel::ShepardWalk, slots>> walks(shepard_.size());
   std::vector<std::int64_t> used(shepard_.size() * slots, 0);  // last use of each walk, per field
   std::vector<double> f(m);
   std::int64_t voxels = 0, warm = 0;

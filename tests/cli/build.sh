@@ -2,7 +2,7 @@
 # End-to-end: `trivox build` (io/scene.hpp, construct/primitives.hpp). Truths: the analytic volumes
 # of the five primitives of models/primitives.json (box 16 x 12 x 8; cylinder pi 6^2 14; frustum
 # pi 12 (7^2 + 7 3 + 3^2) / 3; torus 2 pi^2 8 3^2; ball 4/3 pi 8^3), computed here in Python;
-# their cell counts (1, 5, 5, 5, 7) and topology (22 + 22 + 22 + 24 + 6 V-surfaces, seed 003
+# their cell counts (1, 5, 5, 5, 7) and topology (22 + 22 + 22 + 24 + 6 V-surfaces, Massarwi & Elber 2016
 # Fig. 9; see tests/construct/test_primitives.cpp); a coarse slice's voxel count times the voxel
 # volume is the total volume up to the voxelisation of the surface (3 percent at 35 dpi).
 set -euo pipefail
@@ -77,7 +77,7 @@ expect_fail '/operations/0/op: unknown operation "smooth"; expected one of "unio
 # A scene is refused by commands that need a model, with the hint.
 expect_fail "trivox build SCENE -o MODEL" "$trivox" info models/primitives.json
 
-# revolve (seed 003 Sec. 3.2.2 item 3): the rectangle r in [2, 3], z in [0, 1] in the xz-plane
+# revolve (Massarwi & Elber 2016, Sec. 3.2.2 item 3): the rectangle r in [2, 3], z in [0, 1] in the xz-plane
 # turned about z by 360 degrees (and by 90) is the annulus of volume pi (3^2 - 2^2) (a quarter of
 # it), within the revolution's tolerance (relative 1e-6 of the radius: volume error below
 # 3 x 1e-6 relative); every cell valid; bad angles exit 2.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end: the scene operation "fillet" (seed 000 Alg. 2, Sec. 7.1; Flends Sec. II) built by
+# End-to-end: the scene operation "fillet" (Masalha et al. 2021, Alg. 2, Sec. 7.1; Flends Sec. II) built by
 # `trivox build` and seen by `trivox locate`. Truths: between a floor z <= 0 and a wall x <= 2
 # (boxes, faces chosen), the dip-0 flend is the chamfer, a prism of volume d1 d2 / 2 times the
 # length 4; the Hermite fillet's volume is 4 times the area its section (a cubic with known

@@ -1,5 +1,5 @@
 """Shared by the fillet scripts (tests/cli/*fillet*.sh): the analytic Hermite section of the
-floor-and-wall corner (seed 000 Alg. 1, Eq. 1). In (X, Z) = (x - 2, z) the section is the cubic
+floor-and-wall corner (Masalha et al. 2021, Alg. 1, Eq. 1). In (X, Z) = (x - 2, z) the section is the cubic
 Bezier C1, C1 + T1/3, C2 - T2/3, C2 with C1 = (d1, 0), C2 = (0, d2) and |T_i| = tau |C1 - C2|
 along the faces; with the legs through the origin its area is (1/2) int (X Z' - Z X') (Green's
 theorem), exact with 8 Gauss points (the integrand has degree 5)."""
@@ -32,6 +32,6 @@ def hermite_moment(d1, d2, tau):
     """int X dA over the same region (X the distance from the Z axis): by Green's theorem
     oint X^2 / 2 dZ, where only the section contributes (degree 8: exact with 8 points). A
     quarter turn of the section about the Z axis (a bridging fillet about a vertical edge on a
-    plane, seed 000 Sec. 6.1) has volume (pi / 2) times this (Pappus)."""
+    plane, Masalha et al. 2021, Sec. 6.1) has volume (pi / 2) times this (Pappus)."""
     X, Z, dX, dZ, wts = hermite_section(d1, d2, tau)
     return np.sum(wts * 0.5 * X * X * dZ)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end: the lamp of seed 000 Fig. 15 (models/lamp.json): a base disk, a rod and a
+# End-to-end: the lamp of Masalha et al. 2021, Fig. 15 (models/lamp.json): a base disk, a rod and a
 # spherical head (cylinder, cylinder and sphere primitives, each with its own rgb field),
 # filleted base-rod and rod-head with fitted fillets (Sec. 4.3: the faces are B-splines) and the
 # Shepard blend (Sec. 7.2). The rod's side is four cells, so each junction is four fillets, one

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end: fillets between B-spline faces as matched Bezier pairs (seed 000 Sec. 4.1-4.2,
+# End-to-end: fillets between B-spline faces as matched Bezier pairs (Masalha et al. 2021, Sec. 4.1-4.2,
 # Alg. 4-5; fillet/matched.hpp). A plane (the top of a disk's core cell) meets a cylinder's
 # quarter (a rod's side cell): both faces are B-splines whose knot lines the intersection
 # crosses (Fig. 7's case). With "method": "matched":
@@ -65,7 +65,7 @@ s = json.load(open(sys.argv[1]))
 s["operations"][0]["method"] = sys.argv[3]
 json.dump(s, open(sys.argv[2], "w"))
 PY
-expect_failed 'seed 000 Alg. 5.*method "fit"' "$tmp/sc_model.json" "$trivox" build "$tmp/sc.json" -o "$tmp/sc_model.json"
+expect_failed 'Masalha et al. 2021, Alg. 5.*method "fit"' "$tmp/sc_model.json" "$trivox" build "$tmp/sc.json" -o "$tmp/sc_model.json"
 "$py" - models/fillet_sphere_cone.json "$tmp/sc.json" auto <<'PY'
 import sys, json
 s = json.load(open(sys.argv[1]))

@@ -66,7 +66,7 @@ PY
 expect_fail "no such file" "$trivox" validate "$tmp/none.json"
 
 # Degenerate boundaries: the box and cylinder's ruled fillet cells have det J = 0 along their
-# rails by construction (seed 000 Sec. 9) and > 0 inside: `degenerate`, not invalid. The
+# rails by construction (Masalha et al. 2021, Sec. 9) and > 0 inside: `degenerate`, not invalid. The
 # reported point lies on the domain's boundary and det J there, evaluated independently by
 # central differences of `trivox eval`, is 0 to the scale of the cell.
 "$trivox" build models/box_cylinder.json -o "$tmp/bc.json" > /dev/null

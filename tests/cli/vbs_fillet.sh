@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end: the scene fillet with "construction": "vbs" (seed 000 Sec. 3.2, Alg. 3, Appendix A)
+# End-to-end: the scene fillet with "construction": "vbs" (Masalha et al. 2021, Sec. 3.2, Alg. 3, Appendix A)
 # built by `trivox build`, read back by `trivox info` and `trivox locate`. Truths:
 # - between a floor z <= 0 and a wall x <= 2 (boxes), the Hermite VBS fillet fills the region
 #   between the faces and the cubic section: 4 times the area by Green's theorem (numpy), as the

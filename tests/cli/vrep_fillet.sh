@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end: the scene fillet with "construction": "vrep" (seed 000 Sec. 5, Def. 5.1, Alg. 6:
+# End-to-end: the scene fillet with "construction": "vrep" (Masalha et al. 2021, Sec. 5, Def. 5.1, Alg. 6:
 # the half volumetric Boolean sum trimmed by S^_1, S^_2, S_b and the caps) built by `trivox build`,
 # read back by `trivox locate` and sliced by `trivox slice`. Truths:
 # - between a floor z <= 0 and a wall x <= 2 (boxes), the trimmed cell is the region between the

@@ -1,6 +1,6 @@
 // Constructors (construct/constructors.hpp). Truths: each constructor's closed formula evaluated
 // independently from its inputs at random parameters (ruling, extrusion, Coons patch and volume,
-// half Boolean sums of seed 004 Sec. 3); the boundary interpolation of seed 004 Lemmas 1-3; a
+// half Boolean sums of Fadila et al. 2023, Sec. 3); the boundary interpolation of Fadila et al. 2023 Lemmas 1-3; a
 // sweep reproduces a trivariate that is cubic in w from four of its sections; revolution
 // follows the exact rotation within the stated tolerance and gives the analytic volume of a
 // solid of revolution (Pappus).
@@ -236,7 +236,7 @@ TEST_CASE("volumetric Boolean sum interpolates its six faces and is the trilinea
   const Trivariate T = boolean_sum(faces);
   for (int n = 0; n < 200; ++n) {
     const double u = uniform(), v = uniform(), w = uniform();
-    // Faces interpolated (seed 003 Sec. 3.2.2 item 4).
+    // Faces interpolated (Massarwi & Elber 2016, Sec. 3.2.2 item 4).
     check_close(T.eval({0.0, v, w}), T0.eval({0.0, v, w}), 1e-11);
     check_close(T.eval({1.0, v, w}), T0.eval({1.0, v, w}), 1e-11);
     check_close(T.eval({u, 0.0, w}), T0.eval({u, 0.0, w}), 1e-11);
@@ -271,7 +271,7 @@ TEST_CASE("volumetric Boolean sum interpolates its six faces and is the trilinea
              Catch::Contains("expected six"));
 }
 
-TEST_CASE("half Boolean sums satisfy seed 004 Lemmas 1-3 and their formulas", "[construct]") {
+TEST_CASE("half Boolean sums satisfy Fadila et al. 2023 Lemmas 1-3 and their formulas", "[construct]") {
   // Lemma 1: two curves sharing their start.
   Curve c1 = random_curve(3, 5, 3), c2 = random_curve(4, 4, 3, -2.0, 0.0);
   for (int c = 0; c < 3; ++c) c2.point(0)[c] = c1.point(0)[c];

@@ -1,7 +1,7 @@
-// Kernel-based constructors (construct/kernel_construct.hpp, seed 004 Alg. 1). Truths, checked
+// Kernel-based constructors (construct/kernel_construct.hpp, Fadila et al. 2023, Alg. 1). Truths, checked
 // independently of the code under test: det J from first partials on dense grids (its sign
 // shows the regular construction invalid and the kernel-based one valid), the boundaries equal
-// the inputs (seed 004 Lemmas 1-3, kept because only interior control points move), the
+// the inputs (Fadila et al. 2023 Lemmas 1-3, kept because only interior control points move), the
 // interior control points sit at the kernel centroid, properties stay as the regular
 // construction made them, and a box's kernel centroid is the box's centre.
 #include <catch2/catch.hpp>
@@ -69,7 +69,7 @@ double boundary_gap(const Surface& s, int dir, double at, const Curve& c) {
   return gap;
 }
 
-/// Boolean sum inputs [bottom, top, left, right] from the seed 004 Sec. 5.1 generator (inner
+/// Boolean sum inputs [bottom, top, left, right] from the Fadila et al. 2023, Sec. 5.1 generator (inner
 /// control points rounded): the Coons patch folds, the boundary is star-shaped.
 std::vector<Curve> folded_coons() {
   return {cubic({{-1, -1}, {-0.08, -1.42}, {1.13, -1.37}, {1, -1}}), cubic({{-1, 1}, {0.61, 1.22}, {0.14, 0.99}, {1, 1}}),
@@ -177,7 +177,7 @@ TEST_CASE("Sec. 6: interior points spread on a grid around K give a positive Jac
   }
 }
 
-TEST_CASE("kernel-based half Boolean sum of two curves (seed 004 Lemma 1 boundaries)", "[kernel]") {
+TEST_CASE("kernel-based half Boolean sum of two curves (Fadila et al. 2023, Lemma 1 boundaries)", "[kernel]") {
   const std::vector<Curve> c{cubic({{-1, -1}, {1.01, -1.40}, {0.61, -1.30}, {1, -1}}),
                              cubic({{-1, -1}, {-0.60, -0.65}, {-0.61, -1.04}, {-1, 1}})};
   REQUIRE(det_range(construct::regular_construct(KernelOp::half_boolean_sum, c))[0] < 0.0);
@@ -188,7 +188,7 @@ TEST_CASE("kernel-based half Boolean sum of two curves (seed 004 Lemma 1 boundar
   CHECK(boundary_gap(r.spline, 0, 0.0, c[1]) < 1e-12);
 }
 
-TEST_CASE("kernel-based ruling starts from a ruling at order 3 (seed 004 Sec. 5.1)", "[kernel]") {
+TEST_CASE("kernel-based ruling starts from a ruling at order 3 (Fadila et al. 2023, Sec. 5.1)", "[kernel]") {
   const std::vector<Curve> c{cubic({{-1, -1}, {-0.12, -1.01}, {-0.82, -1.11}, {1, -1}}),
                              cubic({{-1, 1}, {0.61, 0.53}, {-1.44, 1.49}, {1, 1}})};
   const Surface s0 = construct::regular_construct(KernelOp::ruled, c);
@@ -233,7 +233,7 @@ TEST_CASE("a valid regular construction is returned as it is; a boundary without
   CHECK_THROWS_AS(construct::kernel_op_from_name("coons"), Error);
 }
 
-TEST_CASE("kernel-based half Boolean sum trivariate (seed 004 Sec. 3.2, Lemma 2)", "[kernel]") {
+TEST_CASE("kernel-based half Boolean sum trivariate (Fadila et al. 2023, Sec. 3.2, Lemma 2)", "[kernel]") {
   // s1(u,v) = (2u + 4v(1-v) b(u), v, 0), s2(u,w) = (2u + 4w(1-w) b(u), 0, w), b = 1.5 u (1 - u):
   // both faces are valid (x_u = 2 + 4t(1-t) b' >= 0.5), they share C(u) = (2u, 0, 0), and
   // T = s1 + s2 - C has det J = x_u = 2 + (4v(1-v) + 4w(1-w)) b'(u), which is -1 at
@@ -297,7 +297,7 @@ TEST_CASE("kernel-based half Boolean sum trivariate (seed 004 Sec. 3.2, Lemma 2)
   }
 }
 
-TEST_CASE("KernelPoint::fitted: a kernel point where det J's coefficients allow it (seed 004 Sec. 7)", "[kernel]") {
+TEST_CASE("KernelPoint::fitted: a kernel point where det J's coefficients allow it (Fadila et al. 2023, Sec. 7)", "[kernel]") {
   // From the Sec. 5.1 generator (rounded): at the kernel centroid the Jacobian folds at
   // iteration 0; elsewhere in the kernel it does not.
   const std::vector<Curve> c{cubic({{-1, -1}, {0.72, -0.26}, {0.47, -1.13}, {1, -1}}),

@@ -1,4 +1,4 @@
-// Flends between disjoint bodies (seed 002 Sec. III), volumetric: the bridge between two faces.
+// Flends between disjoint bodies (Eager & Dannenhoffer 2019, Sec. III), volumetric: the bridge between two faces.
 // Truths: between aligned boxes the bridge is the box between them (volume 1 for any dip); with
 // the second box lifted by 1 the end lines are parallel and the section's bottom and top edges
 // are translates, so the cross-section has area 1 x 2 (volume 2); the bridge's end faces are

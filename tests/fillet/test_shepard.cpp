@@ -1,4 +1,4 @@
-// Shepard (Euclidean-distance) property blending of fillets (fillet/shepard.hpp; seed 000
+// Shepard (Euclidean-distance) property blending of fillets (fillet/shepard.hpp; Masalha et al. 2021
 // Sec. 7.2). Truths, from the mathematics alone:
 // - the weights: alpha_1 + alpha_2 = 1 (Eq. 9b), alpha_i = 1 where d_i = 0 (Eq. 9a), both in
 //   [0, 1] (Eq. 9c), alpha_1 = d_1^-q / (d_1^-q + d_2^-q);
@@ -17,7 +17,7 @@
 
 #include "trivox/fillet/shepard.hpp"
 #include "trivox/io/model_json.hpp"
-#include "trivox/io/scene.hpp"
+#include "trivox/scene/scene.hpp"
 #include "trivox/spline/extract.hpp"
 
 using namespace trivox;
@@ -41,14 +41,14 @@ double ipow(double x, int q) {
   return r;
 }
 
-const io::SceneBuild& spheres(bool shepard) {
+const scene::SceneBuild& spheres(bool shepard) {
   static const auto build = [](bool s) {
-    auto scene = io::load_scene(std::string(TRIVOX_SOURCE_DIR) + "/models/fillet_spheres.json");
+    auto scene = scene::load_scene(std::string(TRIVOX_SOURCE_DIR) + "/models/fillet_spheres.json");
     for (auto& op : scene.operations)
       if (op.op == "fillet") op.shepard = s;
-    return io::build_scene(scene);
+    return scene::build_scene(scene);
   };
-  static const io::SceneBuild parametric = build(false), with_shepard = build(true);
+  static const scene::SceneBuild parametric = build(false), with_shepard = build(true);
   return shepard ? with_shepard : parametric;
 }
 
@@ -60,7 +60,7 @@ TEST_CASE("Shepard weights: partition of unity, feature preservation, positivity
   for (int q = 1; q <= 16; ++q) {
     for (int n = 0; n < 2000; ++n) {
       const double d1 = U(rng), d2 = U(rng);
-      const auto a = fillet::shepard_weights(d1, d2, q);
+      const auto a = vmodel::shepard_weights(d1, d2, q);
       CHECK(a[0] + a[1] == Approx(1.0).margin(1e-15));
       CHECK(a[0] >= 0.0);
       CHECK(a[1] >= 0.0);
@@ -69,19 +69,19 @@ TEST_CASE("Shepard weights: partition of unity, feature preservation, positivity
       const double e1 = std::pow(d1, -q), e2 = std::pow(d2, -q);
       if (std::isfinite(e1) && std::isfinite(e2) && std::isfinite(e1 + e2)) CHECK(a[0] == Approx(e1 / (e1 + e2)).epsilon(1e-13));
       // Symmetry.
-      const auto b = fillet::shepard_weights(d2, d1, q);
+      const auto b = vmodel::shepard_weights(d2, d1, q);
       CHECK(b[0] == Approx(a[1]).margin(1e-15));
     }
     // On S^_i: alpha_i = 1 exactly.
-    CHECK(fillet::shepard_weights(0.0, 0.7, q)[0] == 1.0);
-    CHECK(fillet::shepard_weights(0.7, 0.0, q)[1] == 1.0);
-    CHECK(fillet::shepard_weights(1e-300, 1.0, q)[0] == 1.0);
+    CHECK(vmodel::shepard_weights(0.0, 0.7, q)[0] == 1.0);
+    CHECK(vmodel::shepard_weights(0.7, 0.0, q)[1] == 1.0);
+    CHECK(vmodel::shepard_weights(1e-300, 1.0, q)[0] == 1.0);
     // On C both vanish: the mean.
-    CHECK(fillet::shepard_weights(0.0, 0.0, q)[0] == 0.5);
+    CHECK(vmodel::shepard_weights(0.0, 0.0, q)[0] == 0.5);
     // Continuity: alpha_1 is monotone in d_1 and continuous (small steps, small changes).
-    double prev = fillet::shepard_weights(0.0, 1.0, q)[0];
+    double prev = vmodel::shepard_weights(0.0, 1.0, q)[0];
     for (int k = 1; k <= 1000; ++k) {
-      const double a1 = fillet::shepard_weights(k * 0.003, 1.0, q)[0];
+      const double a1 = vmodel::shepard_weights(k * 0.003, 1.0, q)[0];
       CHECK(a1 <= prev);
       CHECK(prev - a1 < 0.003 * q);  // |d alpha / d d_1| <= q / (4 d_1) * ... < q near d_1 ~ 1
       prev = a1;
@@ -96,8 +96,8 @@ TEST_CASE("Shepard blend of a planar corner is the analytic formula", "[shepard]
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   for (int q : {1, 2, 3, 8}) {
-    const fillet::ShepardField field({floor_, wall}, q);
-    fillet::ShepardWalk walk;
+    const vmodel::ShepardField field({floor_, wall}, q);
+    vmodel::ShepardWalk walk;
     double worst = 0.0;
     std::array<double, 3> p{2.5, 0.3, 0.4};
     for (int n = 0; n < 3000; ++n) {
@@ -122,7 +122,7 @@ TEST_CASE("Shepard blend of a planar corner is the analytic formula", "[shepard]
     CHECK(walk.warm > 5000);  // nearly every query warm
   }
   // On the floor f is red, on the wall blue (feature preservation), on C the mean.
-  const fillet::ShepardField field({floor_, wall}, 2);
+  const vmodel::ShepardField field({floor_, wall}, 2);
   double f[3];
   field.eval({2.5, 1.0, 0.0}, f);
   CHECK(f[0] == 1.0);
@@ -131,8 +131,8 @@ TEST_CASE("Shepard blend of a planar corner is the analytic formula", "[shepard]
   CHECK(f[2] == 1.0);
   field.eval({2.0, 1.0, 0.0}, f);
   CHECK(f[0] == 0.5);
-  CHECK_THROWS_WITH(fillet::ShepardField({floor_, wall}, 17), Catch::Contains("1..16"));
-  CHECK_THROWS_WITH(fillet::ShepardField({floor_, spline::Surface({KnotVector::bezier(2), KnotVector::bezier(2)}, 3,
+  CHECK_THROWS_WITH(vmodel::ShepardField({floor_, wall}, 17), Catch::Contains("1..16"));
+  CHECK_THROWS_WITH(vmodel::ShepardField({floor_, spline::Surface({KnotVector::bezier(2), KnotVector::bezier(2)}, 3,
                                                                     std::vector<double>(12, 0.0))},
                                           2),
                     Catch::Contains("the same"));
@@ -150,7 +150,7 @@ TEST_CASE("Shepard fillet of two spheres: reproduction on S^_i, pinned face, con
   REQUIRE(b->shepard);
   CHECK(a->shepard->power == 2);
   CHECK(*a->shepard == *b->shepard);
-  const fillet::ShepardField field(*a->shepard);
+  const vmodel::ShepardField field(*a->shepard);
   for (int h = 0; h < 2; ++h) {
     const auto& enc = shp.cells[static_cast<std::size_t>(2 + h)].volume;
     const auto& half = par.cells[static_cast<std::size_t>(2 + h)].volume;
@@ -208,7 +208,7 @@ TEST_CASE("Shepard fillet of two spheres: reproduction on S^_i, pinned face, con
   // Continuity of the exact f along a segment from deep in half a to deep in half b (across
   // their shared face), warm and cold: neighbouring values differ by at most a Lipschitz bound.
   const auto pa = a->volume.eval({0.3, 0.8, 0.5}), pb = b->volume.eval({0.3, 0.2, 0.5});
-  fillet::ShepardWalk walk;
+  vmodel::ShepardWalk walk;
   double prev[3] = {0, 0, 0}, jump = 0.0, warm_cold = 0.0;
   const int n = 2000;
   for (int k = 0; k <= n; ++k) {
@@ -232,7 +232,7 @@ TEST_CASE("Shepard encoding is independent of the thread count", "[shepard]") {
   const auto& par = spheres(false).model;
   const auto& shp = spheres(true).model;
   // As the scene builds it: f from the parametric halves' faces w = 0.
-  const fillet::ShepardField field({spline::boundary_face(par.cells[2].volume, spline::Face::w0),
+  const vmodel::ShepardField field({spline::boundary_face(par.cells[2].volume, spline::Face::w0),
                                     spline::boundary_face(par.cells[3].volume, spline::Face::w0)},
                                    shp.cells[2].shepard->power);
   tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);

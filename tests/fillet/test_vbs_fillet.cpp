@@ -1,4 +1,4 @@
-// The volumetric-Boolean-sum fillet (seed 000 Sec. 3.2, Alg. 3, Appendix A / Alg. 7). Expected
+// The volumetric-Boolean-sum fillet (Masalha et al. 2021, Sec. 3.2, Alg. 3, Appendix A / Alg. 7). Expected
 // values from the mathematics: the corner's fillet region has the volume of the ruled fillet
 // (and of the Hermite section by Green's theorem); the chamfer's C_c(1/2) is the incentre of the
 // right isosceles triangle (Eq. A.2); faces are pieces of the inputs; shared faces coincide.

@@ -181,7 +181,7 @@ TEST_CASE("rational cells are refused with a reason", "[validity]") {
   }
 }
 
-TEST_CASE("seed 003 Fig. 1b: interior control points pushed out of the cuboid are found invalid there", "[validity]") {
+TEST_CASE("Massarwi & Elber 2016, Fig. 1b: interior control points pushed out of the cuboid are found invalid there", "[validity]") {
   // A triquadratic B-spline unit cube (5 x 5 x 5 control points at the Greville abscissae, so
   // X(u,v,w) = (u,v,w) and det J = 1), then three interior control points of the top inner
   // layer (k = 3) pushed up and out of the cuboid to z = 2.5.

@@ -94,7 +94,7 @@ void check_membership(const VModel& m, std::array<double, 3> lo, std::array<doub
 }  // namespace
 
 TEST_CASE("union intersection and subtraction of two boxes: exact membership and cells", "[boolean]") {
-  // Seed 003 Fig. 3: O1 = [0,2]x[0,1]x[0,1], O2 = [1,2]x[0,1]x[0,2]: A = O1 - O2, B = O1 n O2,
+  // Massarwi & Elber 2016, Fig. 3: O1 = [0,2]x[0,1]x[0,1], O2 = [1,2]x[0,1]x[0,2]: A = O1 - O2, B = O1 n O2,
   // C = O2 - O1.
   const std::array<double, 3> a0{0, 0, 0}, a1{2, 1, 1}, b0{1, 0, 0}, b1{2, 1, 2};
   const VModel A = box("A", a0, a1, 0.25), B = box("B", b0, b1, 0.5);
@@ -193,7 +193,7 @@ TEST_CASE("Booleans refuse models that cannot be combined", "[boolean]") {
   CHECK(u.cells[2].name == "A.2");
 }
 
-TEST_CASE("the distance blend of seed 003 Eq. 2 weights each input by its boundary distance", "[boolean]") {
+TEST_CASE("the distance blend of Massarwi & Elber 2016, Eq. 2 weights each input by its boundary distance", "[boolean]") {
   const std::array<double, 3> a0{0, 0, 0}, a1{2, 1, 1}, b0{1, 0, 0}, b1{3, 1, 1};
   for (double k : {1.0, 2.0}) {
     const VModel I = vmodel::boolean(box("A", a0, a1, 0.0), box("B", b0, b1, 1.0), BooleanOp::intersection,
@@ -228,7 +228,7 @@ TEST_CASE("the distance blend of seed 003 Eq. 2 weights each input by its bounda
   }
 }
 
-TEST_CASE("seed 003 Fig. 3: two boxes united give three box cells with the stated topology", "[boolean]") {
+TEST_CASE("Massarwi & Elber 2016, Fig. 3: two boxes united give three box cells with the stated topology", "[boolean]") {
   // O1 = [0,2]x[0,1]x[0,1], O2 = [1,2]x[0,1]x[0,2]: cells A = O1 - O2, B = O1 n O2, C = O2 - O1.
   // Paper: 3 V-cells, 2 internal and 14 boundary V-surfaces (16), 18 half-V-surfaces,
   // 28 V-curves, 16 V-points.

@@ -1,4 +1,4 @@
-// Fillet construction time and sizes (issue 6; Masalha, Cirillo & Elber 2021, seed 000, Sec. 8
+// Fillet construction time and sizes (issue 6; Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8
 // and Table 1): builds the fillet scenes of models/ (default: fillet_spheres, Fig. 13, and
 // fillet_sphere_cone, Fig. 14) `repeats` times and prints, per fillet, the best time to build it
 // (intersection, rails, sub-regions, blend, ruled fillet and its quality report) beside the
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "trivox/io/scene.hpp"
+#include "trivox/scene/scene.hpp"
 
 namespace {
 
@@ -37,7 +37,7 @@ struct PaperRow {
   const char* sb;
   const char* t;
 };
-// Seed 000, Table 1: orders, control points.
+// Masalha et al. 2021, Table 1: orders, control points.
 const PaperRow paper[] = {
     {"Fig. 13", "(4,4) (4,4)", "(4,4) (4,4)", "(7,19) (7,199)", "(7,19) (7,189)", "(4,4) (4,20)", "(7,19,2) (13,275,2)"},
     {"Fig. 14", "(4,2) (13,2)", "(4,4) (13,6)", "(5,13) (5,16-25)", "(7,19) (7,19-79)", "(4,4) (4,20)",
@@ -59,13 +59,13 @@ int main(int argc, char** argv) {
   };
   std::vector<Row> rows;
   for (const auto& path : scenes) {
-    const trivox::io::Scene scene = trivox::io::load_scene(path);
+    const trivox::scene::Scene scene = trivox::scene::load_scene(path);
     std::vector<double> best;
     double best_build = std::numeric_limits<double>::infinity();
-    trivox::io::SceneBuild last;
+    trivox::scene::SceneBuild last;
     for (int r = 0; r < repeats; ++r) {
       const auto t0 = std::chrono::steady_clock::now();
-      trivox::io::SceneBuild b = trivox::io::build_scene(scene);
+      trivox::scene::SceneBuild b = trivox::scene::build_scene(scene);
       best_build = std::min(best_build, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       std::size_t k = 0;
       for (const auto& f : b.fillets)
@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
         rows.push_back({path, q});
       }
   }
-  std::printf("\norders (control points): ours (along C, across[, ruling]) beside seed 000 Table 1\n");
+  std::printf("\norders (control points): ours (along C, across[, ruling]) beside Masalha et al. 2021, Table 1\n");
   std::printf("%-34s %-16s %-16s %-20s %-20s %-18s %-24s\n", "", "S_1", "S_2", "S^_1", "S^_2", "S_b", "T");
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& q = rows[i].q;

@@ -1,5 +1,5 @@
 // Success rates of the kernel-based constructors on the random datasets of Fadila, Hong & Elber
-// (seed 004, Sec. 5.1), beside the paper's figures (captions of Figs. 6, 7, 9, 10, 13, 14).
+// (Fadila et al. 2023, Sec. 5.1), beside the paper's figures (captions of Figs. 6, 7, 9, 10, 13, 14).
 //
 // Nine datasets: {Boolean sum, half Boolean sum, ruling} x {cubic Bezier, quartic Bezier,
 // uniform quadratic B-spline with five control points}. Curves run between corners of [-1, 1]^2
@@ -18,7 +18,7 @@
 // "all" success within the maximum. Each dataset runs twice: with the interior points at the
 // kernel centroid (Alg. 1 line 9, "centroid") and with KernelPoint::fitted ("fitted": the
 // centroid first, then a point of a tighter conservative kernel where det J's coefficients
-// allow it; seed 004 Sec. 7).
+// allow it; Fadila et al. 2023, Sec. 7).
 //
 // Deterministic: candidate i of a dataset draws from its own splitmix64 stream seeded by
 // (seed, dataset, i), candidates are screened in parallel but kept in index order, and each
@@ -104,7 +104,7 @@ Curve make_curve(Kind kind, const Ctl& c) {
   return Curve({kv}, 2, std::move(p));
 }
 
-/// The control polygons of one random input (seed 004 Sec. 5.1), in the order the regular
+/// The control polygons of one random input (Fadila et al. 2023, Sec. 5.1), in the order the regular
 /// constructor takes the curves: Boolean sum [bottom, top, left, right]; half Boolean sum the
 /// top and the left curves, both starting at their shared corner (-1, 1); ruling [bottom, top].
 std::vector<Ctl> random_input(Rng& r, KernelOp op, Kind k, bool sorted) {
@@ -174,7 +174,7 @@ Curve segment(const std::vector<double>& a, const std::vector<double>& b) {
   return Curve({KnotVector::bezier(2)}, 2, {a[0], a[1], b[0], b[1]});
 }
 
-/// The boundary loop that the regular construction will have (seed 004 Lemmas 1-3), built from
+/// The boundary loop that the regular construction will have (Fadila et al. 2023 Lemmas 1-3), built from
 /// the inputs directly so that screening needs no construction: S(u,0), S(1,v), S(u,1) and
 /// S(0,v), the last two reversed.
 std::vector<Curve> input_loop(KernelOp op, const std::vector<Curve>& c) {
@@ -191,7 +191,7 @@ std::vector<Curve> input_loop(KernelOp op, const std::vector<Curve>& c) {
   }
 }
 
-/// Simple boundary and corners turning by less than 180 degrees (seed 004 Sec. 4's assumptions).
+/// Simple boundary and corners turning by less than 180 degrees (Fadila et al. 2023, Sec. 4's assumptions).
 /// Cheapest test first: the corners need only the end tangents, and the sign s for which all
 /// four turn the right way; the orientation (from the signed area) must then be s. The same
 /// verdicts as testing the corners against the orientation directly.
@@ -423,13 +423,13 @@ const char* usage =
     "usage: trivox_bench_kernel_success [--samples N=1000] [--threads N=2] [--seed N=2023]\n"
     "         [--op boolean_sum|half_boolean_sum|ruled|all] [--curves cubic|quartic|quadratic|all]\n"
     "         [--inner unsorted|sorted] [--point centroid|fitted|both] [--retry-spread W=0.5] [--bounds]\n"
-    "Success rates of the kernel-based constructors on the random datasets of seed 004 Sec. 5.1.\n"
+    "Success rates of the kernel-based constructors on the random datasets of Fadila et al. 2023, Sec. 5.1.\n"
     "  --samples   samples kept per dataset (regular construction invalid, boundary with a kernel)\n"
     "  --threads   TBB threads (the table does not depend on it)\n"
     "  --seed      random seed of the datasets\n"
     "  --inner     inner control points as drawn (the paper's text) or sorted along the curve\n"
     "  --point     interior control points at the kernel centroid (Alg. 1), at the fitted point\n"
-    "              when the centroid fails (construct::KernelPoint::fitted, seed 004 Sec. 7), or both\n"
+    "              when the centroid fails (construct::KernelPoint::fitted, Fadila et al. 2023, Sec. 7), or both\n"
     "  --retry-spread  fitted: last try per iteration on the Sec. 6 grid, W x kernel size wide (0: none)\n"
     "  --bounds    also upper bounds for any single interior point (necessary conditions on a\n"
     "              101 x 101 grid): at iteration 0, and with degree raising (every degree) for the\n"
@@ -486,7 +486,7 @@ int main(int argc, char** argv) {
   if (args.point != "fitted") points.push_back(construct::KernelPoint::centroid);
   if (args.point != "centroid") points.push_back(construct::KernelPoint::fitted);
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-  std::printf("Kernel-based constructors on seed 004 Sec. 5.1 random datasets: %d samples each, seed %llu, %d threads, "
+  std::printf("Kernel-based constructors on Fadila et al. 2023, Sec. 5.1 random datasets: %d samples each, seed %llu, %d threads, "
               "inner control points %s\n",
               samples, static_cast<unsigned long long>(seed), threads, sorted ? "sorted along the curve" : "unsorted");
   std::printf("success = det J >= 0 (exact: Bezier coefficients of det J, subdivision) after moving the interior control\n"

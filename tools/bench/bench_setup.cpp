@@ -18,7 +18,7 @@
 
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/slice_job.hpp"
+#include "trivox/job/slice_job.hpp"
 #include "trivox/slice/grid.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/slice/sampler.hpp"
@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
     const double t_volume = best_of(repeats, [&] {
       for (std::size_t c = 0; c < model.cells.size(); ++c) volumes[c] = geom::volume(model.cells[c].volume);
     });
-    const slice::VoxelGrid grid = io::slice_grid(model, slice::printer_preset("j750"));
+    const slice::VoxelGrid grid = job::slice_grid(model, slice::printer_preset("j750"));
     const double t_sampler = best_of(repeats, [&] { const slice::LayerSampler sampler(model, grid); });
     double total_volume = 0.0;
     for (double v : volumes) total_volume += v;

@@ -1,4 +1,4 @@
-// One 1516 x 2524 pixel slice with Shepard-blended fillets (issue 7's benchmark; seed 000
+// One 1516 x 2524 pixel slice with Shepard-blended fillets (issue 7's benchmark; Masalha et al. 2021
 // Sec. 8: about six minutes for the lamp's Fig. 15 (b) slice in IRIT; target: under a second on
 // 2 cores). The slice is WIDTH x HEIGHT square pixels at height Z, one layer, the model's xy
 // bounding box centred in it and touching two opposite sides. Timed: sampling the
@@ -28,7 +28,7 @@
 #include "trivox/error.hpp"
 #include "trivox/fillet/shepard.hpp"
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/scene.hpp"
+#include "trivox/scene/scene.hpp"
 #include "trivox/slice/sampler.hpp"
 
 using namespace trivox;
@@ -75,14 +75,14 @@ Result slice_once(const vmodel::VModel& model, const slice::VoxelGrid& grid, sli
   r.hash = h;
   if (blend == slice::PropertyBlend::shepard) {
     // The Shepard part alone, as apply_shepard runs it: f along each row, warm-started.
-    std::vector<std::unique_ptr<fillet::ShepardField>> fields(model.cells.size());
+    std::vector<std::unique_ptr<vmodel::ShepardField>> fields(model.cells.size());
     for (std::size_t c = 0; c < model.cells.size(); ++c)
-      if (model.cells[c].shepard) fields[c] = std::make_unique<fillet::ShepardField>(*model.cells[c].shepard);
+      if (model.cells[c].shepard) fields[c] = std::make_unique<vmodel::ShepardField>(*model.cells[c].shepard);
     const double c1 = cpu_seconds();
     std::vector<double> f(model.properties.size());
     for (const auto& o : out)
       for (int rr = 0; rr < o.rows; ++rr) {
-        fillet::ShepardWalk walk;
+        vmodel::ShepardWalk walk;
         for (int i = 0; i < o.nx; ++i) {
           const int c = o.cell_at(rr, i);
           if (c < 0 || !fields[static_cast<std::size_t>(c)]) continue;
@@ -127,10 +127,10 @@ int main(int argc, char** argv) try {
   if (!model_file.empty()) {
     model = io::load_model(model_file);
   } else {
-    auto scene = io::load_scene(scene_file);
+    auto scene = scene::load_scene(scene_file);
     for (auto& op : scene.operations)
       if (op.op == "fillet") op.shepard = true;
-    const auto built = io::build_scene(scene);
+    const auto built = scene::build_scene(scene);
     model = built.model;
     std::printf("built %s with Shepard fillets in %.2f s\n", scene_file.c_str(), since(tb));
     for (const auto& f : built.fillets)

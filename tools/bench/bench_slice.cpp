@@ -33,7 +33,7 @@
 #include <vector>
 
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/slice_job.hpp"
+#include "trivox/job/slice_job.hpp"
 #include "trivox/io/slice_stack.hpp"
 #include "trivox/slice/sampler.hpp"
 
@@ -60,18 +60,18 @@ vmodel::VModel scaled(const vmodel::VModel& m, std::array<double, 3> size) {
   return out;
 }
 
-io::SliceJobSummary run(const vmodel::VModel& m, const fs::path& dir, int threads) {
+job::SliceJobSummary run(const vmodel::VModel& m, const fs::path& dir, int threads) {
   fs::remove_all(dir);
-  io::SliceJobOptions opt;
+  job::SliceJobOptions opt;
   opt.profile = slice::printer_preset("j750");
   opt.out_dir = dir;
   opt.force = true;
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
-  return io::run_slice_job(m, opt);
+  return job::run_slice_job(m, opt);
 }
 
 /// A job's pipeline thread-seconds outside its stages (writing and idle).
-double outside_stages(const io::SliceJobSummary& job, int threads) {
+double outside_stages(const job::SliceJobSummary& job, int threads) {
   double staged = 0.0;
   for (double x : job.stage_seconds) staged += x;
   return threads * job.pipeline_seconds - staged;
@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
     std::printf("job: %d x %d x %d, %.3f s, pipeline %.3f s, stages (ns per voxel):", job0.grid.count[0],
                 job0.grid.count[1], job0.grid.count[2], job0.seconds, job0.pipeline_seconds);
     for (std::size_t i = 0; i < job0.stage_seconds.size(); ++i)
-      std::printf(" %s %.1f", io::slice_stage_names[i], 1e9 * job0.stage_seconds[i] / static_cast<double>(job0.voxels));
+      std::printf(" %s %.1f", job::slice_stage_names[i], 1e9 * job0.stage_seconds[i] / static_cast<double>(job0.voxels));
     std::printf(", outside the stages %.3f thread-s\n", outside_stages(job0, threads));
     fs::remove_all(tmp);
     return 0;
@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
     return since(t0);
   };
   // The first job above warmed the caches and wrote the reference slices; these are timed.
-  std::vector<io::SliceJobSummary> jobs;
+  std::vector<job::SliceJobSummary> jobs;
   std::vector<double> floors;
   for (int r = 0; r < repeats; ++r) {
     jobs.push_back(run(model, tmp / "job", threads));
@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
   std::printf("inversion failures: %lld\n", static_cast<long long>(job.inversion_failures));
   std::printf("median job's stages, thread-seconds (ns per voxel):");
   for (std::size_t i = 0; i < job.stage_seconds.size(); ++i)
-    std::printf(" %s %.3f (%.1f)", io::slice_stage_names[i], job.stage_seconds[i],
+    std::printf(" %s %.3f (%.1f)", job::slice_stage_names[i], job.stage_seconds[i],
                 1e9 * job.stage_seconds[i] / static_cast<double>(job.voxels));
   std::printf("\n");
   std::printf("job pipeline (layers sampled to files written): %.3f s wall; thread-seconds outside the stages (writing "

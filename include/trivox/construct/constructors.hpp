@@ -4,9 +4,9 @@
 /// a sequence of sections). Control points live in R^k, any k >= 1: coordinates 0..2 are xyz
 /// (0..1 for planar input) and the rest are properties, which ride along linearly.
 ///
-/// Massarwi & Elber 2016 (seed 003), Sec. 3.2.2: extruded volume T = S + V w, ruled volume
+/// Massarwi & Elber 2016, Sec. 3.2.2: extruded volume T = S + V w, ruled volume
 /// T = (1 - w) S_1 + w S_2, volume of revolution, volumetric Boolean sum of six surfaces, sweep
-/// through surfaces S_i at w_i. Fadila, Hong & Elber (seed 004), Sec. 3: half Boolean sums
+/// through surfaces S_i at w_i. Fadila, Hong & Elber, Sec. 3: half Boolean sums
 /// S = C_1(u) + C_2(v) - P (Sec. 3.1), T = S_1(u,v) + S_2(u,w) - C(u) and
 /// T = S_1(u,v) + S_2(v,w) + S_3(u,w) - (C_1(u) + C_2(v) + C_3(w)) + P (Sec. 3.2). The Boolean
 /// sum is the Coons construction (Elber, Kim & Kim 2012, as the papers use it): the sum of the
@@ -73,17 +73,17 @@ spline::TensorSpline<P> extend_constant(const spline::TensorSpline<P - 1>& s, in
 // ---------------------------------------------------------------------------------------------
 // Extrusion and ruling
 
-/// Ruled surface S(u, v) = (1 - v) bottom(u) + v top(u) (seed 003 Sec. 3.2.2 item 2, one
+/// Ruled surface S(u, v) = (1 - v) bottom(u) + v top(u) (Massarwi & Elber 2016, Sec. 3.2.2 item 2, one
 /// dimension down). `ruling_order` >= 2 raises the ruling direction by degree elevation (the
-/// same surface; seed 004 Sec. 5.1 starts the kernel-based ruling at order 3).
+/// same surface; Fadila et al. 2023, Sec. 5.1 starts the kernel-based ruling at order 3).
 Surface ruled(const Curve& bottom, const Curve& top, int ruling_order = 2);
-/// Ruled volume T(u, v, w) = (1 - w) s0(u, v) + w s1(u, v) (seed 003 Sec. 3.2.2 item 2).
+/// Ruled volume T(u, v, w) = (1 - w) s0(u, v) + w s1(u, v) (Massarwi & Elber 2016, Sec. 3.2.2 item 2).
 Trivariate ruled(const Surface& s0, const Surface& s1, int ruling_order = 2);
 
 /// Extruded surface S(u, v) = C(u) + V v, v in [0, 1]. `vector` has 1..dim entries; missing
 /// ones (the properties) are 0.
 Surface extrude(const Curve& c, std::span<const double> vector);
-/// Extruded volume T(u, v, w) = S(u, v) + V w (seed 003 Sec. 3.2.2 item 1).
+/// Extruded volume T(u, v, w) = S(u, v) + V w (Massarwi & Elber 2016, Sec. 3.2.2 item 1).
 Trivariate extrude(const Surface& s, std::span<const double> vector);
 
 // ---------------------------------------------------------------------------------------------
@@ -106,11 +106,11 @@ struct Revolution {
 /// uniform B-spline interpolant of the unit circle arc with enough segments for the tolerance,
 /// and S's control points are A + c_j R + s_j (a x R) for each of C's control points (A its
 /// projection on the axis, R the radial vector), which is exact up to that interpolant because
-/// the rotation is linear in the point. Seed 003 Sec. 3.2.2 item 3.
+/// the rotation is linear in the point. Massarwi & Elber 2016, Sec. 3.2.2 item 3.
 /// @throws Error (bad_input) on a zero axis, an angle out of range, a tolerance <= 0, or an
 ///         input with fewer than 3 coordinates or rational
 Surface revolve(const Curve& c, const Revolution& r);
-/// Volume of revolution of a surface (seed 003 Sec. 3.2.2 item 3).
+/// Volume of revolution of a surface (Massarwi & Elber 2016, Sec. 3.2.2 item 3).
 Trivariate revolve(const Surface& s, const Revolution& r);
 
 /// The polynomial unit-circle arc used by revolve: a planar clamped curve on [0, 1] with
@@ -133,18 +133,18 @@ Surface boolean_sum(const Curve& bottom, const Curve& top, const Curve& left, co
 /// increasing order). The twelve shared edges must coincide.
 Trivariate boolean_sum(std::span<const Surface> faces, const MatchOptions& match = {});
 
-/// Half Boolean sum surface S(u, v) = c1(u) + c2(v) - c1(0), c1(0) = c2(0) (seed 004 Sec. 3.1,
+/// Half Boolean sum surface S(u, v) = c1(u) + c2(v) - c1(0), c1(0) = c2(0) (Fadila et al. 2023, Sec. 3.1,
 /// Lemma 1: S(u, 0) = c1(u), S(0, v) = c2(v)).
 Surface half_boolean_sum(const Curve& c1, const Curve& c2, const MatchOptions& match = {});
 
 /// Half Boolean sum trivariate of two surfaces sharing C(u) = s1(u, 0) = s2(u, 0):
-/// T(u, v, w) = s1(u, v) + s2(u, w) - C(u) (seed 004 Sec. 3.2, Lemma 2: T(u, v, 0) = s1,
+/// T(u, v, w) = s1(u, v) + s2(u, w) - C(u) (Fadila et al. 2023, Sec. 3.2, Lemma 2: T(u, v, 0) = s1,
 /// T(u, 0, w) = s2).
 Trivariate half_boolean_sum(const Surface& s1, const Surface& s2, const MatchOptions& match = {});
 
 /// Half Boolean sum trivariate of three surfaces s1(u, v), s2(v, w), s3(u, w) sharing
 /// C1(u) = s1(u, 0) = s3(u, 0), C2(v) = s1(0, v) = s2(v, 0), C3(w) = s2(0, w) = s3(0, w) and the
-/// corner P: T = s1 + s2 + s3 - (C1 + C2 + C3) + P (seed 004 Sec. 3.2, Lemma 3: T(u, v, 0) = s1,
+/// corner P: T = s1 + s2 + s3 - (C1 + C2 + C3) + P (Fadila et al. 2023, Sec. 3.2, Lemma 3: T(u, v, 0) = s1,
 /// T(0, v, w) = s2, T(u, 0, w) = s3).
 Trivariate half_boolean_sum(const Surface& s1, const Surface& s2, const Surface& s3,
                             const MatchOptions& match = {});
@@ -157,7 +157,7 @@ Trivariate half_boolean_sum(const Surface& s1, const Surface& s2, const Surface&
 /// the sections' control points (NURBS Book eq. 9.5), normalised to [0, 1]; else n strictly
 /// increasing values, mapped onto [0, 1].
 Surface sweep(std::span<const Curve> sections, std::span<const double> params = {}, int order = 4);
-/// The trivariate through surfaces S_i at w_i: T(u, v, w_i) = S_i(u, v) (seed 003 Sec. 3.2.2
+/// The trivariate through surfaces S_i at w_i: T(u, v, w_i) = S_i(u, v) (Massarwi & Elber 2016, Sec. 3.2.2
 /// item 5, volumetric sweep by interpolation).
 Trivariate sweep(std::span<const Surface> sections, std::span<const double> params = {},
                  int order = 4);

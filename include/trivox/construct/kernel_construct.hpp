@@ -3,7 +3,7 @@
 /// regular constructor's boundary but move every interior control point to a kernel point of
 /// that boundary, adding degrees of freedom until the Jacobian is valid.
 ///
-/// Fadila, Hong & Elber (seed 004), Sec. 4, Alg. 1 (planar surfaces from curves; trivariates from
+/// Fadila, Hong & Elber, Sec. 4, Alg. 1 (planar surfaces from curves; trivariates from
 /// surfaces likewise, Sec. 5 end): S_0 = the regular construction; if S_0 is valid, return it;
 /// else K = the centroid of the (conservative, Hong & Elber 2022) kernel of S_0's boundary
 /// (geom/kernel.hpp); no kernel: fail; else for i = 0..max_dof, S_i = S_0 refined with i uniform
@@ -41,7 +41,7 @@ const char* kernel_op_name(KernelOp op) noexcept;
 /// @throws trivox::Error (bad_input) for any other name
 KernelOp kernel_op_from_name(std::string_view name);
 
-/// How degrees of freedom are added per iteration (seed 004 Alg. 1, AddDOF).
+/// How degrees of freedom are added per iteration (Fadila et al. 2023, Alg. 1, AddDOF).
 enum class AddDof {
   refine,   ///< i uniform knots inserted in every span of every direction
   elevate,  ///< every direction's degree raised i times
@@ -50,7 +50,7 @@ enum class AddDof {
 /// What counts as a valid result.
 enum class Acceptance {
   /// det J >= 0 with the boundary's orientation (zero allowed where interior points coincide at
-  /// K: seed 004 Theorem 4 and Sec. 5, the criterion of the paper's success rates). Checked
+  /// K: Fadila et al. 2023, Theorem 4 and Sec. 5, the criterion of the paper's success rates). Checked
   /// like geom::check_validity (Bezier coefficients of det J, subdivision), with coefficients
   /// within 1e-9 of the largest |coefficient| counted as zero.
   nonnegative,
@@ -58,13 +58,13 @@ enum class Acceptance {
   positive,
 };
 
-/// Where the interior control points go (seed 004 Alg. 1 line 9; Sec. 7).
+/// Where the interior control points go (Fadila et al. 2023, Alg. 1 line 9; Sec. 7).
 enum class KernelPoint {
   /// The centroid of the conservative kernel, at every iteration (the paper's Alg. 1).
   centroid,
   /// The centroid first; when S_i is not accepted there, the centroid of the part of the kernel
   /// where det J's Bezier coefficients (pieces subdivided up to `fit_subdivisions` times where
-  /// needed) all have the boundary's sign, if that part has positive area (volume). Seed 004
+  /// needed) all have the boundary's sign, if that part has positive area (volume). Fadila et al. 2023
   /// Sec. 7 names "a more careful selection of the interior kernel location" as the degree of
   /// freedom the paper did not exercise. With every interior point at K (or at K plus the fixed
   /// Sec. 6 offsets), det J is affine in K: the cross (triple) products of the derivatives lose
@@ -80,7 +80,7 @@ struct KernelConstructOptions {
   /// Largest number of knots per span (refine) or degree raisings (elevate) tried: iterations
   /// i = 0..max_dof. The paper: 20 knots per span; degree up to 17 (40 for quadratic ruling).
   int max_dof = 20;
-  /// Seed 004 Sec. 6: 0 moves every interior point to K; s > 0 spreads them on a uniform grid
+  /// Fadila et al. 2023, Sec. 6: 0 moves every interior point to K; s > 0 spreads them on a uniform grid
   /// centred at K, s times the kernel's size wide (sqrt(area), cbrt(volume)) along axes taken
   /// from the control net (first to last layer per direction).
   double spread = 0.0;
@@ -99,7 +99,7 @@ struct KernelConstructOptions {
   /// `retry_spread` x kernel size wide, centred at the point fitted for that grid (det J stays
   /// affine in the centre). 0: no retry.
   double retry_spread = 0.0;
-  int ruling_order = 3;             ///< order of the ruling direction (seed 004 Sec. 5.1: 3)
+  int ruling_order = 3;             ///< order of the ruling direction (Fadila et al. 2023, Sec. 5.1: 3)
   geom::KernelOptions kernel{};     ///< refinement of the kernel computation
   geom::ValidityOptions validity{}; ///< subdivision limits of the validity checks
   /// Boundary matching of the regular constructors; geometry_coords -1 means 2 for surfaces
@@ -136,13 +136,13 @@ struct KernelResult {
   std::string reason;
 };
 
-/// Seed 004 Alg. 1 from a given regular construction s0 (any constructor, clamped on its
+/// Fadila et al. 2023, Alg. 1 from a given regular construction s0 (any constructor, clamped on its
 /// domain), for planar surfaces (xy) and trivariates (xyz).
 /// @throws trivox::Error (bad_input) for a rational s0 or too few coordinates
 template <int P>
 KernelResult<P> kernel_based(const spline::TensorSpline<P>& s0, const KernelConstructOptions& options = {});
 
-/// The regular construction of seed 004 (Alg. 1 line 1) from planar curves (R^k, x y first):
+/// The regular construction of Fadila et al. 2023 (Alg. 1 line 1) from planar curves (R^k, x y first):
 /// boolean_sum [bottom, top, left, right] (S(u,0), S(u,1), S(0,v), S(1,v)); half_boolean_sum
 /// [c1, c2] with c1(0) = c2(0); ruled [bottom, top] with the ruling at `ruling_order`.
 /// @throws trivox::Error (bad_input) for the wrong number of curves or mismatched boundaries

@@ -1,10 +1,10 @@
 /// @file trivox/construct/primitives.hpp
-/// @brief The non-singular primitives of Massarwi & Elber 2016 (seed 003), Sec. 3.2.3, Fig. 9:
+/// @brief The non-singular primitives of Massarwi & Elber 2016, Sec. 3.2.3, Fig. 9:
 /// a box, and a cylinder, cone, torus and sphere made of several polynomial cells, none of which
 /// has a vanishing Jacobian; and the property fields that colour them.
 ///
 /// A tensor-product trivariate cylinder or sphere is singular on its axis or at its poles
-/// (seed 003 Fig. 8). The primitives avoid that by splitting the solid into cells glued C0 along
+/// (Massarwi & Elber 2016, Fig. 8). The primitives avoid that by splitting the solid into cells glued C0 along
 /// shared faces (Sec. 3.2.3):
 ///
 ///  - a *5-cell disk*: a central square of half-width 0.5 r and four cells ruled between the

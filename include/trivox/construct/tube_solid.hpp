@@ -4,7 +4,7 @@
 ///
 /// A single tensor-product cell whose sleeve is a smooth tube is singular: splitting the closed
 /// cross-section into the four sides of a Coons patch puts angles of pi at its corners, where
-/// det J vanishes. Massarwi & Elber 2016 (seed 003), Sec. 3.2.3 (Fig. 9 a) avoid that for the
+/// det J vanishes. Massarwi & Elber 2016, Sec. 3.2.3 (Fig. 9 a) avoid that for the
 /// cylinder by a 5-cell disk; here the same disk is swept along any tube S(u, v) (u around, v
 /// along): with Q_k(v) = S(k/4, v), the centre c(v) = (Q_0 + Q_1 + Q_2 + Q_3) / 4 and the core's
 /// corners K_k(v) = c + core (Q_k - c),
@@ -12,7 +12,7 @@
 ///    t = 1), its w direction the tube's v;
 ///  - `s0` .. `s3`: cell k between the core's side K_k K_{k+1} (w = 0) and the quarter of the tube
 ///    S(u, v), u in [k/4, (k+1)/4] (w = 1); (s, v, w): s around, v along, w outward.
-/// Each cell is construct::boolean_sum (seed 003 Sec. 3.2.2 item 4) of its six faces, all ruled
+/// Each cell is construct::boolean_sum (Massarwi & Elber 2016, Sec. 3.2.2 item 4) of its six faces, all ruled
 /// surfaces or quarters of S, so the cells are exactly the ruled constructions and glue along
 /// shared faces (the core's t = 1 and s = 0 sides run backwards against s2's and s3's w = 0).
 /// Where S's cross-sections are convex and advance along v (each cross-section planar or nearly,

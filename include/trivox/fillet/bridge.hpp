@@ -2,7 +2,7 @@
 /// @brief A flend between disjoint bodies: the trivariate that bridges a face of one cell to a
 /// face of another, leaving each cell tangentially.
 ///
-/// Eager & Dannenhoffer, Flends (seed 002), Sec. III, made volumetric. Per point (u, v) of the
+/// Eager & Dannenhoffer 2019 (Flends), Sec. III, made volumetric. Per point (u, v) of the
 /// two faces A (of cell 1) and B (of cell 2): the end directions d_A, d_B are the cells' own
 /// derivatives across their faces, pointing out of the cells (at the faces' edges these are
 /// tangent to the adjacent faces, the directions Sec. III.A asks for); the faux intersection

@@ -2,7 +2,7 @@
 /// @brief Functional composition of a surface with a curve or a surface in its parameter space,
 /// and the fillet sub-regions S^_i of the primary surfaces built with it.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 1.5, Eqs. 2-3: the part of S_i between the
+/// Masalha, Cirillo & Elber 2021, Sec. 1.5, Eqs. 2-3: the part of S_i between the
 /// intersection curve and the rail is S^_i(u, v) = S_i(Rld(c_a(u), c_b(u))(v)), the image of the
 /// ruled surface between the two curves in S_i's parameter space. When that ruled surface stays
 /// inside one polynomial piece of S_i, the composition is a tensor-product spline: for a piece of
@@ -38,10 +38,10 @@ bool crosses_knot_lines(const spline::Surface& s, const spline::Surface& r);
 
 enum class SubregionMethod {
   compose,    ///< exact composition; refused where the region crosses knot lines of s
-  fit,        ///< least-squares fit with pinned boundaries (seed 000 Sec. 4.3)
+  fit,        ///< least-squares fit with pinned boundaries (Masalha et al. 2021, Sec. 4.3)
   automatic,  ///< compose where possible, else fit; fillet_faces tries `matched` first
   /// fillet_faces: B-spline faces whose knot lines C crosses, as matched Bezier pairs composed
-  /// exactly (seed 000 Alg. 4-5, fillet/matched.hpp); subregion() treats it as compose
+  /// exactly (Masalha et al. 2021, Alg. 4-5, fillet/matched.hpp); subregion() treats it as compose
   matched,
 };
 
@@ -64,7 +64,7 @@ struct SubregionReport {
   double fit_error = 0.0;  ///< fit: largest xyz distance found at the check points
 };
 
-/// S^(u, v) = s((1 - v) from(u) + v to(u)) (seed 000 Eqs. 2-3), u along the curves, v from
+/// S^(u, v) = s((1 - v) from(u) + v to(u)) (Masalha et al. 2021 Eqs. 2-3), u along the curves, v from
 /// `from` (v = 0) to `to` (v = 1). The curves are in s's parameter space and in one function
 /// space (same order and knots). A fit keeps its two boundaries exactly on s(from) and s(to) as
 /// fitted curves: S^(u, 0) and S^(u, 1) are themselves least-squares curves of those images.

@@ -2,7 +2,7 @@
 /// @brief Fillets over several faces whose intersection curve is only piecewise C1, and the
 /// singular fillets that bridge the gaps at its convex corners.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 6 and 6.1, Fig. 12 (a box and a cylinder).
+/// Masalha, Cirillo & Elber 2021, Sec. 6 and 6.1, Fig. 12 (a box and a cylinder).
 /// Two bodies, given as lists of faces S_{1,i} (side 1) and S_{2,j} (side 2), meet along
 /// C = U C_{i,j}, C_{i,j} = S_{1,i} n S_{2,j}: closed (or open) and only piecewise C1.
 ///

@@ -2,7 +2,7 @@
 /// @brief The volumetric fillet between two cells: from the intersection of two boundary faces
 /// to the fillet trivariates and their quality report.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000) for two primary surfaces S_1, S_2 (faces of two
+/// Masalha, Cirillo & Elber 2021 for two primary surfaces S_1, S_2 (faces of two
 /// cells, in R^k with their properties): per component C of S_1 n S_2 (geom/surface_intersection)
 /// the rails at distances d_1, d_2 (Sec. 1.2, fillet/rails.hpp), the sub-regions S^_i between C
 /// and the rails (Sec. 1.5 and 4.3, fillet/compose.hpp), the blending surface S_b (Alg. 1, or
@@ -65,7 +65,7 @@ struct FilletOptions {
   VrepOptions vrep;  ///< the join tolerance, for Construction::vrep
 };
 
-/// Orders and control-point counts, as seed 000 Table 1 lists them.
+/// Orders and control-point counts, as Masalha et al. 2021, Table 1 lists them.
 struct SplineShape {
   std::vector<int> orders, counts;
 };
@@ -107,7 +107,7 @@ struct Fillet {
   FilletQuality quality;
   /// The rails of the intersection component this fillet belongs to (over the whole component,
   /// also for a matched piece of it), and the component's index in intersect_surfaces' order:
-  /// what the multi-face fillet of fillet/corners.hpp (seed 000 Sec. 6) joins at the corners.
+  /// what the multi-face fillet of fillet/corners.hpp (Masalha et al. 2021, Sec. 6) joins at the corners.
   RailPair rails;
   std::size_t component = 0;
 
@@ -121,7 +121,7 @@ double outward_sign(const spline::Trivariate& cell, spline::Face face);
 
 /// The fillets between face f1 of cell1 and face f2 of cell2, one per intersection component, or
 /// with matched Bezier pairs (SubregionMethod::matched, or automatic on B-spline faces where
-/// Lemma 1 holds; fillet/matched.hpp, seed 000 Alg. 4-5) one per piece, in order along C.
+/// Lemma 1 holds; fillet/matched.hpp, Masalha et al. 2021, Alg. 4-5) one per piece, in order along C.
 /// @throws Error (bad_input) for cells of different dimensions, faces that do not intersect
 ///         ("... do not intersect"), an intersection that is only a point, distances or
 ///         parameters out of range or rails leaving their face (the message names the face);

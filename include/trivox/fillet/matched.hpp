@@ -3,7 +3,7 @@
 /// curve and the rails cut where iso-parametric lines of either face cross them, so that every
 /// piece of each sub-region lies in one polynomial piece of its face and is composed exactly.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 4.1-4.2:
+/// Masalha, Cirillo & Elber 2021, Sec. 4.1-4.2:
 /// - Subdivision values (Alg. 4): every interior knot line of S_i (u = u_0 or v = v_0) that the
 ///   intersection curve crosses in S_i's parameters, at C(t_0) (Eq. 6: u^{S_i}(t_0) = u_0, all
 ///   roots), gives S_j an iso-line through c^{S_j}(t_0) as well, the one "most orthogonal to"
@@ -22,7 +22,7 @@
 ///   the fillet runs along C from t_p to t_{p+1} and along rail i from r_{i,p} to r_{i,p+1};
 ///   its boundary between pieces is, on each face, a segment of the iso-line from C to the rail,
 ///   so the sub-region pieces (ruled surfaces in the face's parameters between the reparametrised
-///   pieces of c^{S_i} and c_i^r, seed 000 Eqs. 2-3) stay inside one Bezier patch and compose
+///   pieces of c^{S_i} and c_i^r, Masalha et al. 2021 Eqs. 2-3) stay inside one Bezier patch and compose
 ///   exactly (compose.hpp). Neighbouring pieces share that boundary, the blending surfaces
 ///   interpolate the same end points with the same tangent fields, so the fillets of Alg. 5's
 ///   line 20 (BzrFillet, Alg. 2) join continuously.

@@ -2,9 +2,9 @@
 /// @brief Rail curves of a fillet: the Euclidean offset of the intersection curve C on a primary
 /// surface, at a chosen distance, on the side of the face that lies outside the other cell.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 1.2: the rail C_i^r is the curve on S_i at
-/// Euclidean distance d_i from C (after Elber & Kim 2020). Found as in Eager & Dannenhoffer,
-/// Flends (seed 002), Sec. II.B: from each point of C, small steps on the surface along
+/// Masalha, Cirillo & Elber 2021, Sec. 1.2: the rail C_i^r is the curve on S_i at
+/// Euclidean distance d_i from C (after Elber & Kim 2020). Found as in Eager &
+/// Dannenhoffer 2019 (Flends), Sec. II.B: from each point of C, small steps on the surface along
 /// n x C' (the direction in the tangent plane perpendicular to C; the least-squares (du, dv) of
 /// the 3 x 2 system), each pulled back into C's normal plane, until the point is about d away;
 /// then Newton on the 2 x 2 system |S(u,v) - C(t)|^2 = d^2, (S(u,v) - C(t)) . C'(t) = 0 puts it
@@ -72,7 +72,7 @@ struct Rail {
 /// rails[1].base, rails[1].rail) share one parameter t in [0, 1] and one function space (order
 /// 4, the same clamped knots; interior knots of multiplicity 3 at the trimmed ends of either
 /// rail), so that the ruled surfaces (1 - s) base(t) + s rail(t) are tensor-product splines
-/// (seed 000, Eq. 3) and S_1(rails[0].base(t)) = S_2(rails[1].base(t)) = C(t) at the same t (to
+/// (Masalha et al. 2021, Eq. 3) and S_1(rails[0].base(t)) = S_2(rails[1].base(t)) = C(t) at the same t (to
 /// the tolerance).
 struct RailPair {
   std::array<Rail, 2> rails;

@@ -2,7 +2,7 @@
 /// @brief The ruled-volume fillet between two primary surfaces, with its properties blended
 /// parametrically.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Alg. 2: T(u, v, w) = Rld(S^_12, S_b) = (1 - w)
+/// Masalha, Cirillo & Elber 2021, Alg. 2: T(u, v, w) = Rld(S^_12, S_b) = (1 - w)
 /// S^_12(u, v) + w S_b(u, v), S^_12 = S^_1 joined with S^_2 along C (Eq. 5), after bringing
 /// everything into one function space by degree raising and knot refinement. Properties
 /// (coordinates 3..k-1) follow Sec. 7.1: S_b carries g_b, whose control points are

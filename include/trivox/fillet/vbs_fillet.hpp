@@ -3,7 +3,7 @@
 /// into three cube-like cells, each the volumetric Boolean sum of its four sleeve surfaces and
 /// two Coons caps. No face collapses to a curve.
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 3.2 and Alg. 3, with the division of
+/// Masalha, Cirillo & Elber 2021, Sec. 3.2 and Alg. 3, with the division of
 /// Appendix A / Alg. 7. The cross-section of the fillet space is a curvilinear triangle with
 /// corners C (where S^_1 meets S^_2) and the rails R_1, R_2 (where S_b meets S^_i):
 ///
@@ -45,7 +45,7 @@
 ///
 /// Jacobians: T_1 has no degenerate edge (the angle at C is the faces' dihedral angle). T_2 and
 /// T_3 each have one zero-angle edge, the rail, where S_b is tangent to S^_i (G1): det J vanishes
-/// along it (seed 000 Sec. 9, "at the rail curves, the Jacobian of all presented approaches
+/// along it (Masalha et al. 2021, Sec. 9, "at the rail curves, the Jacobian of all presented approaches
 /// vanish"), positive elsewhere when the division does not fold.
 ///
 /// Knots across that come from different pieces (restrictions, normalisations, reversal) and

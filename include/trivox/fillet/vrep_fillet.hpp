@@ -3,8 +3,8 @@
 /// volumetric Boolean sum of S^_1 and S^_2, trimmed by the fillet's boundary surfaces S^_1, S^_2,
 /// S_b (and, for an open C, the two capping surfaces).
 ///
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 5, Def. 5.1, Lemma 2 and Alg. 6, in the V-rep
-/// framework of Massarwi & Elber 2016 (seed 003, Def. 3.2: a V-cell is the part of a trivariate
+/// Masalha, Cirillo & Elber 2021, Sec. 5, Def. 5.1, Lemma 2 and Alg. 6, in the V-rep
+/// framework of Massarwi & Elber 2016 (Def. 3.2: a V-cell is the part of a trivariate
 /// delineated by trimming surfaces).
 ///
 /// - T_hbs(u, v, w) = S^_1(u, v) + S^_2(u, w) - C(u) (Def. 5.1, Alg. 6 line 2), with v measured
@@ -18,7 +18,7 @@
 ///   (vmodel::VCell::without: point membership exact by inversion, as the Booleans use it, and
 ///   what slice::apply_trimming and Locator::admits honour), so S_b is given as the face of the
 ///   solid W beyond it: W_1 = Rld(S_b[0, v_b], T_hbs v1) and W_2 = Rld(S_b[v_b, 1], T_hbs w1
-///   reversed), the ruled volumes (seed 003 Sec. 3.2.2) between S_b and the far faces of T_hbs,
+///   reversed), the ruled volumes (Massarwi & Elber 2016, Sec. 3.2.2) between S_b and the far faces of T_hbs,
 ///   glued along Rld(C_b, K). The fillet is the cell {T_hbs without {W_1, W_2}}: its boundary is
 ///   S^_1, S^_2 (T_hbs), S_b (W's face w0) and, for an open C, the caps: T_hbs's end faces
 ///   trimmed by the loop of Alg. 6 line 11: C_u, C_v (the cap's edges v = 0, w = 0) and C_Sb, where

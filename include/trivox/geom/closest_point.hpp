@@ -2,7 +2,7 @@
 /// @brief The point of a surface closest to a given point, and so the distance from a point to a
 /// set of surfaces (the boundary of a V-model).
 ///
-/// Massarwi & Elber 2016 (seed 003), Sec. 5.2, Eq. 3 with C(t) = P: the closest point is where
+/// Massarwi & Elber 2016, Sec. 5.2, Eq. 3 with C(t) = P: the closest point is where
 /// <P - S(u,v), S_u> = <P - S(u,v), S_v> = 0, or on the domain's boundary. Solved here
 /// numerically rather than by a subdivision solver: a precomputed grid of samples (a few per
 /// knot span and direction) picks the start, then Newton on the gradient of |S - P|^2 / 2 (with

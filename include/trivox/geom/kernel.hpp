@@ -2,7 +2,7 @@
 /// @brief Conservative kernels of closed loops of planar curves and of closed sets of surfaces:
 /// a convex polygon (polyhedron) of points that see the whole boundary.
 ///
-/// Hong & Elber 2022 (cited in seed 004, Secs. 2 and 5.1): a point K is in the kernel of a closed
+/// Hong & Elber 2022 (cited in Fadila et al. 2023, Secs. 2 and 5.1): a point K is in the kernel of a closed
 /// boundary iff it lies on the inner side of every tangent line (plane). For a counter-clockwise
 /// loop of curves C that is f_K(t) = C'(t) x (K - C(t)) >= 0 for all t; for surfaces with outward
 /// normals n = S_u x S_v it is g_K(u,v) = n(u,v) . (K - S(u,v)) <= 0. Both f_K and g_K are
@@ -43,7 +43,7 @@ struct PlanarKernel {
   /// Counter-clockwise vertices; empty when no kernel point was found.
   std::vector<std::array<double, 2>> vertices;
   double area = 0.0;
-  /// The interior kernel point of seed 004 Alg. 1 (line 9): the polygon's centroid.
+  /// The interior kernel point of Fadila et al. 2023, Alg. 1 (line 9): the polygon's centroid.
   std::array<double, 2> centroid{0.0, 0.0};
   /// +1 when the loop runs counter-clockwise, -1 clockwise (from its signed area).
   int orientation = 0;
@@ -59,7 +59,7 @@ struct SpatialKernel {
   /// Its faces, each a list of indices into `vertices`, counter-clockwise seen from outside.
   std::vector<std::vector<int>> faces;
   double volume = 0.0;
-  std::array<double, 3> centroid{0.0, 0.0, 0.0};  ///< interior kernel point (seed 004 Alg. 1)
+  std::array<double, 3> centroid{0.0, 0.0, 0.0};  ///< interior kernel point (Fadila et al. 2023, Alg. 1)
   /// +1 when the given normals point outward, -1 when they point inward (from the signed volume).
   int orientation = 0;
   int constraints = 0;  ///< half-spaces used
@@ -79,7 +79,7 @@ PlanarKernel planar_kernel(std::span<const spline::Curve> loop, const KernelOpti
 /// reversed, S(u0, v) reversed (counter-clockwise when det J > 0).
 std::vector<spline::Curve> boundary_loop(const spline::Surface& s);
 
-/// planar_kernel(boundary_loop(s)): the kernel of a planar surface's boundary (seed 004 Sec. 5.1
+/// planar_kernel(boundary_loop(s)): the kernel of a planar surface's boundary (Fadila et al. 2023, Sec. 5.1
 /// uses the boundary of the regular construction S_0 as the kernel's input).
 PlanarKernel planar_kernel(const spline::Surface& s, const KernelOptions& options = {});
 
@@ -101,7 +101,7 @@ SpatialKernel spatial_kernel(const spline::Trivariate& t, const KernelOptions& o
 /// The part of a kernel polygon where further affine constraints hold: {a, b, c} keeps the
 /// points with a x + b y + c >= 0. Constraints with (a, b) = 0 keep everything when c >= 0 and
 /// nothing otherwise. The result's `constraints` counts k's and the ones given; `orientation` is
-/// k's. Used to pick the kernel point of seed 004 Alg. 1 more carefully (Sec. 7), where det J's
+/// k's. Used to pick the kernel point of Fadila et al. 2023, Alg. 1 more carefully (Sec. 7), where det J's
 /// coefficients, affine in that point, give the constraints (construct/kernel_construct.hpp).
 PlanarKernel restrict_kernel(const PlanarKernel& k, std::span<const std::array<double, 3>> constraints);
 

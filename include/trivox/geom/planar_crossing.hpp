@@ -1,6 +1,6 @@
 /// @file trivox/geom/planar_crossing.hpp
 /// @brief Whether planar curves cross one another or themselves: the input check of the planar
-/// constructors (seed 004 Sec. 4 assumes boundaries that are "intersection and
+/// constructors (Fadila et al. 2023, Sec. 4 assumes boundaries that are "intersection and
 /// self-intersection free").
 ///
 /// Each curve (coordinates 0..1) is flattened into a polyline whose chords stay within

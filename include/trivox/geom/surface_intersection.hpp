@@ -2,9 +2,9 @@
 /// @brief The intersection curves of two parametric surfaces in R^3: every component, open or
 /// closed, as points on both surfaces and as B-spline curves in xyz and in both parameter spaces.
 ///
-/// What the fillets start from (Masalha, Cirillo & Elber 2021, seed 000, Sec. 1.1: the
+/// What the fillets start from (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 1.1: the
 /// intersection curve C of the two primary surfaces) and what the Booleans' boundary V-surfaces
-/// are trimmed by (Massarwi & Elber 2016, seed 003, Sec. 4). The method is the classical one of
+/// are trimmed by (Massarwi & Elber 2016, Sec. 4). The method is the classical one of
 /// marching with Newton correction (Barnhill & Kersey 1990; Patrikalakis & Maekawa, Shape
 /// Interrogation, 2002, Sec. 5.8):
 /// 1. Seeds: pairs of Bezier pieces whose control boxes overlap are subdivided (the larger of

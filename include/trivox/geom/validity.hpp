@@ -2,7 +2,7 @@
 /// @brief Whether a trivariate (or a planar surface) is a valid parametrisation: its Jacobian
 /// determinant keeps one strict sign over the whole domain.
 ///
-/// Massarwi & Elber 2016 (seed 003, Sec. 3.3) and Fadila, Hong & Elber (seed 004, Sec. 2): the
+/// Massarwi & Elber 2016 (Sec. 3.3) and Fadila, Hong & Elber (Sec. 2): the
 /// determinant det[dX/du, dX/dv, dX/dw] of a polynomial cell is itself a B-spline
 /// (spline::jacobian_determinant, from derivative and product splines). In Bezier form its
 /// coefficients bound it (convex hull) and its corner coefficients are its values there. So a

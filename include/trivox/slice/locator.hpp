@@ -2,7 +2,7 @@
 /// @brief Point location in a V-model: which cell contains a point xyz, and at which (u,v,w).
 ///
 /// The inverse of the cells' maps X_c(u,v,w) -> xyz, the question every voxel of a print job asks
-/// (Masalha, Cirillo & Elber 2021, seed 000, Sec. 8: a V-model is "sliced" by sampling geometry and
+/// (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8: a V-model is "sliced" by sampling geometry and
 /// materials together at every voxel of every layer; their research code took minutes per slice).
 ///
 /// How: every cell is cut into its Bezier pieces (polynomial or rational, kept in Bernstein form
@@ -212,7 +212,7 @@ public:
 
   const vmodel::VModel& model() const noexcept;
 
-  // ---- Booleans (seed 003 Sec. 4): trimmed cells ----
+  // ---- Booleans (Massarwi & Elber 2016, Sec. 4): trimmed cells ----
   /// True when some cell is trimmed (not VCell::plain()).
   bool has_trims() const noexcept;
   /// True when cell c is trimmed.
@@ -222,7 +222,7 @@ public:
   /// the tolerance). Always true for plain cells. When `props` is not null it holds the
   /// trivariate's own m values on entry and, if p is admitted, leaves with c's blended
   /// properties: combined with the within cells' values at p (their own blends applied) by the
-  /// cell's rule (sum clipped to [0, 1], the mean, or seed 003 Eq. 2's distance weights: one
+  /// cell's rule (sum clipped to [0, 1], the mean, or Massarwi & Elber 2016, Eq. 2's distance weights: one
   /// closest-point query per boundary surface of each input). Unchanged for plain cells and
   /// BlendRule::first. One point location per condition, whether or not props are wanted.
   bool admits(int cell, const Vec3& p, double* props = nullptr) const;

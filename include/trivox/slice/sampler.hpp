@@ -2,7 +2,7 @@
 /// @brief Sampling a V-model on a printer's voxel grid, a band of image rows at a time: per voxel
 /// the cell that contains its centre (or void) and the model's properties there.
 ///
-/// The print job's hot path (Masalha, Cirillo & Elber 2021, seed 000, Sec. 8: V-models sliced
+/// The print job's hot path (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8: V-models sliced
 /// into Voxel Print images, geometry and materials together; their research code took about six
 /// minutes for a 1516 x 2524 slice). A layer is processed in blocks of 4 image rows, cell by cell
 /// in file order (a voxel taken by a cell is skipped by later ones: the first cell wins on
@@ -68,7 +68,7 @@
 /// exactly (one point location per condition for each voxel of a trimmed cell).
 ///
 /// Shepard fillets (SamplerOptions::blend = shepard): after a block is sampled, every voxel held
-/// by a cell with Shepard data gets f at its centre (fillet/shepard.hpp), the walk of warm starts
+/// by a cell with Shepard data gets f at its centre (vmodel/shepard_field.hpp), the walk of warm starts
 /// running along each row of the block; cells without it are untouched.
 ///
 /// Determinism: a block's result depends only on the block (layer and its 4 image rows); a band
@@ -87,7 +87,7 @@
 #include <string_view>
 #include <vector>
 
-#include "trivox/fillet/shepard.hpp"
+#include "trivox/vmodel/shepard_field.hpp"
 
 #include "trivox/slice/grid.hpp"
 #include "trivox/slice/locator.hpp"
@@ -126,7 +126,7 @@ struct RowBand {
 /// Which properties the fillet cells that carry Shepard data (vmodel::ShepardData) get.
 enum class PropertyBlend : std::uint8_t {
   encoded,  ///< their control points' (the least-squares encoding of f): the default
-  /// f itself, exactly per voxel (seed 000 Sec. 7.2; fillet/shepard.hpp): two closest-point
+  /// f itself, exactly per voxel (Masalha et al. 2021, Sec. 7.2; vmodel/shepard_field.hpp): two closest-point
   /// queries per voxel of those cells, warm-started along each image row of a block (cold at
   /// every row's first such voxel), so a voxel's value depends only on its block.
   shepard,
@@ -187,7 +187,7 @@ private:
   /// Per cell: index into shepard_ (-1: no Shepard data or the encoded blend); cells with equal
   /// data (the two halves of a fillet) share one field.
   std::vector<int> shepard_of_;
-  std::vector<std::unique_ptr<fillet::ShepardField>> shepard_;
+  std::vector<std::unique_ptr<vmodel::ShepardField>> shepard_;
   mutable std::atomic<std::int64_t> shepard_voxels_{0}, shepard_warm_{0};
 };
 

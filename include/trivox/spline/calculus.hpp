@@ -45,8 +45,8 @@ template <int P>
 TensorSpline<P> coordinates(const TensorSpline<P>& s, int first, int count);
 
 /// The Jacobian determinant det[dX/du, dX/dv, dX/dw] of the xyz coordinates of a polynomial
-/// trivariate, as a scalar trivariate: du . (dv x dw) (Massarwi & Elber 2016, seed 003, Sec. 3.3;
-/// Fadila, Hong & Elber, seed 004, Sec. 2: validity from the signs of its coefficients).
+/// trivariate, as a scalar trivariate: du . (dv x dw) (Massarwi & Elber 2016, Sec. 3.3;
+/// Fadila, Hong & Elber, Fadila et al. 2023, Sec. 2: validity from the signs of its coefficients).
 Trivariate jacobian_determinant(const Trivariate& s);
 
 /// For a planar surface (xy coordinates): det[dX/du, dX/dv] as a scalar surface.

@@ -1,5 +1,5 @@
 /// @file trivox/vmodel/boolean.hpp
-/// @brief Union, intersection and subtraction of V-models (Massarwi & Elber 2016, seed 003,
+/// @brief Union, intersection and subtraction of V-models (Massarwi & Elber 2016,
 /// Sec. 4, Alg. 1-3), with exact point membership.
 ///
 /// The result's cells are the pieces of the inputs' cells, mutually exclusive, as in the paper:
@@ -39,7 +39,7 @@ const char* boolean_op_name(BooleanOp op) noexcept;
 struct BooleanOptions {
   /// How intersection cells blend the two inputs' properties.
   BlendRule blend = BlendRule::sum_clip;
-  /// k of the distance blend (seed 003 Eq. 2 with d^k), > 0.
+  /// k of the distance blend (Massarwi & Elber 2016, Eq. 2 with d^k), > 0.
   double power = 1.0;
   /// Names of the result's cells: intersection cells are "<a><join><b>"; cells of A - B and
   /// B - A keep their names. Repeated names get a suffix ".2", ".3", ...

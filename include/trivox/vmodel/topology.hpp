@@ -2,7 +2,7 @@
 /// @brief The topology of a V-model: half-V-surfaces, V-surfaces, V-curves and V-points, and
 /// which cell faces are glued to which.
 ///
-/// Massarwi & Elber 2016 (seed 003), Sec. 3.1, Defs. 3.4-3.9 and Sec. 3.1.1 (gluing). Every
+/// Massarwi & Elber 2016, Sec. 3.1, Defs. 3.4-3.9 and Sec. 3.1.1 (gluing). Every
 /// boundary face of a cell that has area is a *half-V-surface*; two half-V-surfaces of different
 /// cells that coincide geometrically are glued into one interior *V-surface*, and a half-V-surface
 /// glued to nothing is a boundary V-surface on its own. The cells' edges, merged where they

@@ -1,6 +1,6 @@
 /// @file trivox/vmodel/vmodel.hpp
 /// @brief The V-model: a complex of volumetric cells whose control points carry xyz plus
-/// properties (Massarwi & Elber 2016, seed 003, Sec. 3.1).
+/// properties (Massarwi & Elber 2016, Sec. 3.1).
 ///
 /// This is the data every module passes around. Topology (V-surfaces, half-V-surfaces,
 /// V-curves, V-points), trimming and Booleans build on it.
@@ -18,12 +18,12 @@
 namespace trivox::vmodel {
 
 /// How the properties of a cell that lies in several inputs' cells combine (Booleans,
-/// seed 003 Sec. 3.1.2): the cell's own trivariate and each `within` cell give values at a point.
+/// Massarwi & Elber 2016, Sec. 3.1.2): the cell's own trivariate and each `within` cell give values at a point.
 enum class BlendRule {
   first,    ///< the cell's own trivariate alone
-  sum_clip, ///< the sum of all values, clipped to [0, 1] (seed 003 Fig. 5: colours summed)
+  sum_clip, ///< the sum of all values, clipped to [0, 1] (Massarwi & Elber 2016, Fig. 5: colours summed)
   mean,     ///< their average
-  /// Seed 003 Eq. 2: the average weighted by d_i^k, d_i the distance from the point to the
+  /// Massarwi & Elber 2016, Eq. 2: the average weighted by d_i^k, d_i the distance from the point to the
   /// boundary of the input model that value i comes from (VCell::boundaries), k = blend_power.
   /// On the boundary of one input, the other inputs' values alone remain, so the attribute is C0
   /// across the intersection cell's boundary. (Eq. 2 measures the distance to the part of that
@@ -38,7 +38,7 @@ const char* blend_rule_name(BlendRule r) noexcept;
 bool blend_rule_from_name(std::string_view name, BlendRule& out) noexcept;
 
 /// Trimming curves on one boundary face of a cell's trivariate: where the other input of a
-/// Boolean cuts that face (surface-surface intersection, seed 003 Sec. 4), as curves in the
+/// Boolean cuts that face (surface-surface intersection, Massarwi & Elber 2016, Sec. 4), as curves in the
 /// face's parameter space (R^2; the face's parameters are the two other directions in order).
 struct FaceTrim {
   spline::Face face = spline::Face::u0;
@@ -48,7 +48,7 @@ struct FaceTrim {
 };
 
 /// The data of a fillet cell whose properties are the Euclidean-distance (Shepard) blend of
-/// Masalha, Cirillo & Elber 2021 (seed 000), Sec. 7.2, after Biswas et al. 2004: at a point p,
+/// Masalha, Cirillo & Elber 2021, Sec. 7.2, after Biswas et al. 2004: at a point p,
 /// f(p) = alpha_1 g_1(pi_1(p)) + alpha_2 g_2(pi_2(p)), alpha_i = d_i^-q / (d_1^-q + d_2^-q), d_i
 /// the distance from p to the fillet's sub-region S^_i, pi_i(p) its closest point there and g_i
 /// the properties S^_i carries. The cell's own property control points hold the least-squares
@@ -64,7 +64,7 @@ struct ShepardData {
 
 /// One volumetric cell: a trivariate in R^(3+m), coordinates 0..2 xyz and 3.. the properties.
 ///
-/// A plain cell is the image of its trivariate. A cell made by a Boolean operation (seed 003
+/// A plain cell is the image of its trivariate. A cell made by a Boolean operation (Massarwi & Elber 2016
 /// Sec. 4, Alg. 1-3) is *trimmed*: it is the part of that image that lies in every `within` cell
 /// and in none of the cells of any `without` list (Def. 3.2: a V-cell is in the intersection of
 /// one or more trivariates; here the trimming is given by the other inputs' cells themselves, so

@@ -1,4 +1,4 @@
-/// @file trivox/io/vdb_job.hpp
+/// @file trivox/job/vdb_job.hpp
 /// @brief The OpenVDB output of a print job: sample a V-model on a uniform cubic voxel grid and
 /// write `DIR/<name>.vdb` with its density, colour, material fractions and other properties.
 ///
@@ -46,7 +46,7 @@
 #include "trivox/slice/sampler.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 /// Options of the VDB output (`trivox slice --vdb`).
 struct VdbJobOptions {
@@ -129,4 +129,4 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& options);
 VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& options,
                           const VdbProgress& progress = {});
 
-}  // namespace trivox::io
+}  // namespace trivox::job

@@ -1,4 +1,4 @@
-/// @file trivox/io/manifest.hpp
+/// @file trivox/job/manifest.hpp
 /// @brief What a print job wrote, and from what: `DIR/manifest.json` (or one part per shard),
 /// which makes every job verifiable, resumable and splittable across machines.
 ///
@@ -26,7 +26,7 @@
 
 #include "trivox/io/slice_stack.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 /// One finished layer.
 struct ManifestLayer {
@@ -112,7 +112,7 @@ std::string option_number(double v);
 
 /// The ConfigFile.xml of the job's PNG stack: resolution, size and palette from the manifest,
 /// with voxel counts `totals` (one per material).
-StackConfig stack_config_of(const Manifest& manifest, const std::vector<std::int64_t>& totals);
+io::StackConfig stack_config_of(const Manifest& manifest, const std::vector<std::int64_t>& totals);
 
 /// The manifest as JSON text (2-space indented, keys in a fixed order, ending with a newline).
 std::string manifest_json(const Manifest& manifest);
@@ -126,4 +126,4 @@ Manifest parse_manifest(std::string_view text, const std::string& source);
 /// @throws Error (bad_input) when it exists but cannot be read or parsed
 std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name);
 
-}  // namespace trivox::io
+}  // namespace trivox::job

@@ -1,4 +1,4 @@
-#include "trivox/io/slice_job.hpp"
+#include "trivox/job/slice_job.hpp"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -18,8 +18,8 @@
 #include <system_error>
 #include <time.h>
 
-#include "png_codec.hpp"
-#include "png_rows.hpp"
+#include "../io/png_codec.hpp"
+#include "../io/png_rows.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/sha256.hpp"
@@ -29,7 +29,7 @@
 #include "trivox/slice/material.hpp"
 #include "trivox/slice/sampler.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 namespace fs = std::filesystem;
 
@@ -130,7 +130,7 @@ void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vecto
   const bool png = id.options.count("png") == 0 || id.options.at("png") != "no";
   const bool last = id.shard.index == id.shard.count - 1;
   if (png && !last) return;
-  for (const auto& [n, name] : detail::list_slices(dir, StackConfig{}.prefix))
+  for (const auto& [n, name] : io::detail::list_slices(dir, io::StackConfig{}.prefix))
     if (!png || n >= id.layer_range[1]) remove(dir / name);
 }
 
@@ -177,7 +177,7 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
   // Probe writability now rather than after the first layer (a name of this shard's own).
   const fs::path probe = dir / (".trivox-write-test" + (id.shard.count > 1 ? "-" + std::to_string(id.shard.index) : std::string()));
   try {
-    write_file_atomically(probe, "", Durability::deferred);  // removed at once: no fsync
+    io::write_file_atomically(probe, "", io::Durability::deferred);  // removed at once: no fsync
   } catch (const Error& e) {
     throw Error(dir.string() + ": the folder is not writable; expected a writable folder");
   }
@@ -232,7 +232,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
 
   // The PNG module now (png_codec.hpp): when it cannot be loaded the job stops here, before a
   // folder is made or a layer sampled.
-  (void)detail::png_codec();
+  (void)io::detail::png_codec();
 
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
   const slice::MaterialMapper mapper(palette, model.properties, opt.palette ? opt.palette->string() : std::string());
@@ -263,7 +263,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   manifest.options["png.dpi"] = option_number(opt.profile.dpi_x) + "," + option_number(opt.profile.dpi_y);
   manifest.options["png.layer_mm"] = option_number(opt.profile.layer_mm);
   manifest.options["png.printer"] = opt.profile.name;
-  manifest.options["png.palette"] = palette.name + (opt.palette ? " " + sha256_file(*opt.palette) : std::string(" (built in)"));
+  manifest.options["png.palette"] = palette.name + (opt.palette ? " " + io::sha256_file(*opt.palette) : std::string(" (built in)"));
   manifest.options["png.dither"] = std::string(slice::dither_mode_name(mode));
   manifest.options["png.zip"] = opt.zip ? "yes" : "no";
   manifest.grid = grid.count;
@@ -278,7 +278,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   manifest.layer_range = opt.shard.range(nz);
   // The archive's place is checked before the slices are written, not after.
   if (opt.zip) {
-    const fs::path zip = gcvf_path(opt.out_dir);
+    const fs::path zip = io::gcvf_path(opt.out_dir);
     std::error_code ec;
     if (fs::is_directory(zip, ec))
       throw Error(zip.string() + ": is a folder; expected a .gcvf file path to write (--zip packs DIR as DIR.gcvf)");
@@ -289,7 +289,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
       throw Error(zip.string() + ": exists; expected a new archive (--force to replace it, or another output folder)");
   }
   const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt.force, opt.resume);
-  StackConfig cfg = stack_config_of(manifest, {});
+  io::StackConfig cfg = stack_config_of(manifest, {});
 
   std::map<int, ManifestLayer> finished;  // by layer
   std::vector<int> todo;
@@ -300,7 +300,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
         const ManifestLayer* l = previous->layer(k);
         std::error_code ec;
         const fs::path f = opt.out_dir / cfg.slice_name(k);
-        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && fs::is_regular_file(f, ec) && sha256_file(f) == l->sha256;
+        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && fs::is_regular_file(f, ec) && io::sha256_file(f) == l->sha256;
       });
     for (int k = manifest.layer_range[0]; k < manifest.layer_range[1]; ++k)
       if (keep[static_cast<std::size_t>(k)]) finished.emplace(k, *previous->layer(k));
@@ -318,8 +318,8 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   auto sync_and_write = [](const fs::path& dir, const Manifest& m) {
     // A manifest listing no layer (a new job's first) vouches for no file: no sync needed (it
     // cost 3 ms here, a whole file system's dirty pages elsewhere).
-    if (!m.layers.empty()) sync_folder_contents(dir);
-    write_file_atomically(dir / m.shard.manifest_name(), manifest_json(m));
+    if (!m.layers.empty()) io::sync_folder_contents(dir);
+    io::write_file_atomically(dir / m.shard.manifest_name(), manifest_json(m));
   };
   auto write_manifest = [&](bool complete) {
     list_finished(manifest, complete);
@@ -379,9 +379,9 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
 
   // A layer's PNG, from its pixels (RGBA) or its material indices, and the PNG's digest.
   auto encode = [&](LayerOut& out, const std::uint8_t* pixels, bool indexed) {
-    out.png = indexed ? encode_png_indexed(pixels, nx, ny, colour, cfg.dpi_x, cfg.dpi_y)
-                      : encode_png_rgba(pixels, nx, ny, cfg.dpi_x, cfg.dpi_y);
-    out.sha256 = sha256_hex(out.png);
+    out.png = indexed ? io::encode_png_indexed(pixels, nx, ny, colour, cfg.dpi_x, cfg.dpi_y)
+                      : io::encode_png_rgba(pixels, nx, ny, cfg.dpi_x, cfg.dpi_y);
+    out.sha256 = io::sha256_hex(out.png);
   };
 
   auto sample_layer = [&](int k) {
@@ -491,7 +491,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
           tbb::make_filter<std::vector<LayerOut>, void>(tbb::filter_mode::serial_in_order, [&](std::vector<LayerOut> outs) {
             for (LayerOut& out : outs) {
               const std::string name = cfg.slice_name(out.layer);
-              write_file_atomically(opt.out_dir / name, out.png, Durability::deferred);
+              io::write_file_atomically(opt.out_dir / name, out.png, io::Durability::deferred);
               finished[out.layer] = ManifestLayer{out.layer, name, out.sha256, out.counts, out.failures};
               ++done;
               if (std::chrono::duration<double>(Clock::now() - last_manifest).count() >= opt.manifest_interval_s) {
@@ -533,15 +533,15 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   cfg = stack_config_of(manifest, totals);
   if (opt.shard.count == 1) {
     // The configuration that makes the folder a complete stack, once every layer is on disk.
-    sync_folder_contents(opt.out_dir);
-    const std::string config = config_xml(cfg);
-    write_file_atomically(opt.out_dir / "ConfigFile.xml", config);
-    manifest.files.push_back({"config", "ConfigFile.xml", sha256_hex(config)});
+    io::sync_folder_contents(opt.out_dir);
+    const std::string config = io::config_xml(cfg);
+    io::write_file_atomically(opt.out_dir / "ConfigFile.xml", config);
+    manifest.files.push_back({"config", "ConfigFile.xml", io::sha256_hex(config)});
     if (opt.zip) {
-      const fs::path zip = gcvf_path(opt.out_dir);
-      zip_stack(opt.out_dir, zip);
+      const fs::path zip = io::gcvf_path(opt.out_dir);
+      io::zip_stack(opt.out_dir, zip);
       sum.zip_file = zip;
-      manifest.files.push_back({"zip", "../" + zip.filename().string(), sha256_file(zip)});
+      manifest.files.push_back({"zip", "../" + zip.filename().string(), io::sha256_file(zip)});
     }
   }
   write_manifest(opt.last_output);
@@ -558,7 +558,7 @@ void finish_manifest(const fs::path& dir, const Shard& shard, const std::vector<
     m->files.push_back(f);
   }
   m->complete = true;
-  write_file_atomically(dir / shard.manifest_name(), manifest_json(*m));
+  io::write_file_atomically(dir / shard.manifest_name(), manifest_json(*m));
 }
 
-}  // namespace trivox::io
+}  // namespace trivox::job

@@ -1,4 +1,4 @@
-/// @file trivox/io/slice_job.hpp
+/// @file trivox/job/slice_job.hpp
 /// @brief The print job: sample a V-model on a printer's voxel grid, map each voxel's properties
 /// to one printable material, and write a GrabCAD Voxel Print PNG stack.
 ///
@@ -28,12 +28,12 @@
 #include <string>
 #include <vector>
 
-#include "trivox/io/manifest.hpp"
+#include "trivox/job/manifest.hpp"
 #include "trivox/slice/grid.hpp"
 #include "trivox/slice/sampler.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 struct SliceJobOptions {
   slice::PrintProfile profile = {};            ///< resolution and tray
@@ -119,4 +119,4 @@ void finish_manifest(const std::filesystem::path& dir, const Shard& shard, const
 SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions& options,
                               const SliceProgress& progress = {});
 
-}  // namespace trivox::io
+}  // namespace trivox::job

@@ -1,10 +1,10 @@
-#include "trivox/io/scene.hpp"
+#include "trivox/scene/scene.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <map>
 
-#include "json_io.hpp"
+#include "../io/json_io.hpp"
 #include "scene_construct.hpp"
 
 #include "trivox/error.hpp"
@@ -15,11 +15,11 @@
 #include "trivox/slice/trim.hpp"
 #include "trivox/vmodel/boolean.hpp"
 
-namespace trivox::io {
+namespace trivox::scene {
 
 namespace {
 
-using namespace json_io;
+using namespace io::json_io;
 using construct::Vec3;
 
 std::string known_operations() {
@@ -199,8 +199,8 @@ std::vector<vmodel::NamedSurface> read_surfaces(const Source& src, const json& r
     const std::string ip = child("/surfaces", i);
     const json& item = expect_object(src, (*j)[i], ip, "an object " + what);
     std::string name = read_name(src, item, ip, names);
-    if (scene_detail::is_derived_surface(item)) {  // "gismo" patches or an "offset" (scene_construct.hpp)
-      derived.push_back(scene_detail::read_derived_surface(src, item, ip, std::move(name)));
+    if (detail::is_derived_surface(item)) {  // "gismo" patches or an "offset" (scene_construct.hpp)
+      derived.push_back(detail::read_derived_surface(src, item, ip, std::move(name)));
       continue;
     }
     out.push_back({std::move(name), read_spline<2>(src, require(src, item, ip, "surface", what), child(ip, "surface"), shape)});
@@ -233,7 +233,7 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
   };
   o.across = between[0].is_array() || between[1].is_array();
   if (o.across) {
-    // Seed 000 Sec. 6: every listed face of one side against every listed face of the other.
+    // Masalha et al. 2021, Sec. 6: every listed face of one side against every listed face of the other.
     for (std::size_t i = 0; i < 2; ++i) {
       const std::string ep = child(bp, i);
       const json& e = between[i];
@@ -287,14 +287,14 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     if (v != "bridge" && v != "open") src.fail(cp, "unknown corners " + quote(v) + "; expected \"bridge\" or \"open\"");
     if (!o.across)
       src.fail(cp, "\"corners\" with one face per side; expected lists of faces in \"between\" (a fillet over "
-                   "several faces, seed 000 Sec. 6)");
+                   "several faces, Masalha et al. 2021, Sec. 6)");
     o.corners.bridge = v == "bridge";
   }
   if (o.across)
     for (const char* key : {"bridge", "construction", "blend", "power"})
       if (find(item, key))
         src.fail(child(ip, key), std::string("\"") + key + "\" with a fillet over several faces; expected the ruled "
-                                 "construction and the parametric blend (seed 000 Sec. 6 joins ruled fillets)");
+                                 "construction and the parametric blend (Masalha et al. 2021, Sec. 6 joins ruled fillets)");
   if (const json* b = find(item, "bridge")) {
     if (!b->is_boolean()) fail_type(src, child(ip, "bridge"), *b, "true or false");
     o.bridge = b->get<bool>();
@@ -330,10 +330,10 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     if (!fillet::section_from_name(sec.c_str(), f.blend.section))
       src.fail(child(ip, "section"), "unknown section " + quote(sec) + "; expected \"hermite\" or \"flend\"");
     if (o.across && o.corners.bridge && f.blend.section != fillet::Section::hermite)
-      src.fail(child(ip, "section"), "the bridging fillets at corners (seed 000 Sec. 6.1) take the Hermite section; "
+      src.fail(child(ip, "section"), "the bridging fillets at corners (Masalha et al. 2021, Sec. 6.1) take the Hermite section; "
                                      "expected \"section\": \"hermite\", or \"corners\": \"open\"");
     if (o.bridge && f.blend.section != fillet::Section::flend)
-      src.fail(child(ip, "section"), "a bridge is a flend (seed 002 Sec. III); expected \"section\": \"flend\"");
+      src.fail(child(ip, "section"), "a bridge is a flend (Eager & Dannenhoffer 2019, Sec. III); expected \"section\": \"flend\"");
   }
   if (const json* t = find(item, "dip")) {
     f.blend.dip = read_number(src, *t, child(ip, "dip"));
@@ -355,7 +355,7 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
     o.shepard_power = read_int(src, *t, child(ip, "power"), 1, 16, "a power q, an integer in 1..16");
     if (!o.shepard) src.fail(child(ip, "power"), "a power without \"blend\": \"shepard\"; expected it only with the Shepard blend");
   }
-  if (const json* t = find(item, "construction")) {  // seed 000 Alg. 2, Sec. 3.2 / Alg. 3 or Sec. 5 / Alg. 6
+  if (const json* t = find(item, "construction")) {  // Masalha et al. 2021, Alg. 2, Sec. 3.2 / Alg. 3 or Sec. 5 / Alg. 6
     const std::string cp = child(ip, "construction");
     const std::string c = read_string(src, *t, cp, "\"ruled\", \"vbs\" or \"vrep\"");
     if (!fillet::construction_from_name(c.c_str(), f.construction))
@@ -420,7 +420,7 @@ std::vector<SceneOperation> read_operations(const Source& src, const json& root,
       }
     }
     if (op == "fillet") read_fillet(src, item, ip, o);
-    if (scene_detail::is_constructor(op)) scene_detail::read_constructor(src, item, ip, o, properties);
+    if (detail::is_constructor(op)) detail::read_constructor(src, item, ip, o, properties);
     out.push_back(std::move(o));
   }
   return out;
@@ -441,7 +441,7 @@ const vmodel::VCell& find_cell(const Source& src, const Objects& objects, const 
                 "<name>.<part>)");
 }
 
-/// Seed 000 Sec. 6 / 6.1: the fillet over several faces (fillet/corners.hpp): its pieces' cells
+/// Masalha et al. 2021, Sec. 6 / 6.1: the fillet over several faces (fillet/corners.hpp): its pieces' cells
 /// <name>.<k>a, <name>.<k>b in chain order, the bridges' <name>.c<j>a, <name>.c<j>b.
 template <class Objects>
 std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOperation& op, const Objects& objects,
@@ -477,7 +477,7 @@ std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOpe
       if (q.jacobian() == "changes sign")
         throw Error(src.at(op.pointer) + ": fillet " + base + " between " + sides[0][piece.face[0]].name + " and " +
                         sides[1][piece.face[1]].name + ": det J changes sign inside (from " + format_double(q.det_min) +
-                        " to " + format_double(q.det_max) + "); expected a valid fillet: try other distances or tau",
+                        " to " + format_double(q.det_max) + "); expected a io::valid fillet: try other distances or tau",
                     ErrorKind::failed);
       rep.cell_names.push_back({base + "a", base + "b"});
       rep.quality.push_back(q);
@@ -508,7 +508,7 @@ std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOpe
       throw Error(src.at(op.pointer) + ": the bridging fillet " + base + " at the corner (" + format_double(jn.o[0]) +
                       ", " + format_double(jn.o[1]) + ", " + format_double(jn.o[2]) + "): det J changes sign inside (from " +
                       format_double(cf.quality.det_min) + " to " + format_double(cf.quality.det_max) +
-                      "); expected a valid fillet: try other distances or tau",
+                      "); expected a io::valid fillet: try other distances or tau",
                   ErrorKind::failed);
     for (std::size_t c = 0; c < 2; ++c) cells.emplace_back(rep.cell_names[c], cf.cells[c]);
     out.corners.push_back(std::move(rep));
@@ -527,7 +527,7 @@ std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOpe
   return cells;
 }
 
-/// Seed 000 Alg. 2 (or Sec. 3.2 / Alg. 3 with "construction": "vbs", Sec. 5 / Alg. 6 with
+/// Masalha et al. 2021, Alg. 2 (or Sec. 3.2 / Alg. 3 with "construction": "vbs", Sec. 5 / Alg. 6 with
 /// "vrep") between two cells: the faces (given, or the one intersecting pair), the fillets, their
 /// cells named <name>.<k>a and <name>.<k>b (vbs: <name>.<k>.1, .2, .3; vrep: the trimmed cell
 /// <name>.<k>).
@@ -622,7 +622,7 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
     if (q.jacobian() == "changes sign")
       throw Error(src.at(op.pointer) + ": fillet " + std::to_string(k + 1) + " of " + quote(op.name) +
                       ": det J changes sign inside (from " + format_double(q.det_min) + " to " +
-                      format_double(q.det_max) + "); expected a valid fillet: try other distances or tau",
+                      format_double(q.det_max) + "); expected a io::valid fillet: try other distances or tau",
                   ErrorKind::failed);
     const std::string base = op.name + "." + std::to_string(k + 1);
     // Ruled (Alg. 2): the halves <base>a, <base>b; VBS (Alg. 3): T_1, T_2, T_3 as <base>.1 .. .3;
@@ -640,12 +640,12 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
       for (std::size_t c = 0; c < names.size(); ++c) cells.push_back(fillets[k].vcell(c, names[c]));
       continue;
     }
-    // Seed 000 Sec. 7.2: both halves carry f, encoded, and S^_1, S^_2 (their faces w = 0) for
+    // Masalha et al. 2021, Sec. 7.2: both halves carry f, encoded, and S^_1, S^_2 (their faces w = 0) for
     // the exact per-voxel value.
     vmodel::ShepardData sd;
     sd.power = op.shepard_power;
     for (std::size_t h = 0; h < 2; ++h) sd.sources[h] = spline::boundary_face(fillets[k].cells[h], spline::Face::w0);
-    const fillet::ShepardField field(sd);
+    const vmodel::ShepardField field(sd);
     for (std::size_t h = 0; h < 2; ++h) {
       auto enc = fillet::encode_shepard(fillets[k].cells[h], field, {.power = op.shepard_power});
       rep.shepard.push_back({enc.max_error, enc.rms_error, enc.check_error, enc.samples, enc.seconds});
@@ -690,11 +690,11 @@ void apply_operations(const Scene& scene, const Source& src, SceneBuild& out) {
     return std::find_if(objects.begin(), objects.end(), [&](const Object& o) { return o.name == name; });
   };
   for (const SceneOperation& op : scene.operations) {
-    if (scene_detail::is_constructor(op.op)) {
+    if (detail::is_constructor(op.op)) {
       if (find_object(op.name) != objects.end())
         src.fail(op.pointer + "/name", quote(op.name) + " names another cell or result; expected a fresh name");
-      if (!surfaces) surfaces = scene_detail::resolve_surfaces(scene, src, out);
-      objects.push_back({op.name, scene_detail::apply_constructor(scene, src, op, *surfaces, out), -1});
+      if (!surfaces) surfaces = detail::resolve_surfaces(scene, src, out);
+      objects.push_back({op.name, detail::apply_constructor(scene, src, op, *surfaces, out), -1});
       continue;
     }
     if (op.op == "fillet") {
@@ -758,8 +758,8 @@ void apply_operations(const Scene& scene, const Source& src, SceneBuild& out) {
 
 }  // namespace
 
-construct::Field scene_detail::read_field(const Source& src, const json& j, const std::string& ptr, std::size_t properties) {
-  return io::read_field(src, j, ptr, properties);
+construct::Field detail::read_field(const Source& src, const json& j, const std::string& ptr, std::size_t properties) {
+  return scene::read_field(src, j, ptr, properties);
 }
 
 Scene read_scene_json(std::string_view text, const std::string& source) {
@@ -781,13 +781,13 @@ Scene read_scene_json(std::string_view text, const std::string& source) {
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& path) { return read_scene_json(read_file(path), path.string()); }
+Scene load_scene(const std::filesystem::path& path) { return read_scene_json(io::read_file(path), path.string()); }
 
 SceneBuild build_scene(const Scene& scene) {
   const Source src{scene.source};
   for (const SceneOperation& op : scene.operations) {
     const bool boolean = op.op == "union" || op.op == "intersection" || op.op == "subtraction";
-    if (boolean || op.op == "fillet" || scene_detail::is_constructor(op.op)) continue;
+    if (boolean || op.op == "fillet" || detail::is_constructor(op.op)) continue;
     src.fail(op.pointer + "/op",
              quote(op.op) + " is not supported yet in scenes (`trivox construct` runs it on its own); expected "
                  "union, intersection, subtraction, fillet, ruled, boolean_sum, half_boolean_sum, extrude, revolve or sweep");
@@ -836,4 +836,4 @@ SceneBuild build_scene(const Scene& scene) {
   return out;
 }
 
-}  // namespace trivox::io
+}  // namespace trivox::scene

@@ -1,4 +1,4 @@
-/// @file trivox/io/merge.hpp
+/// @file trivox/job/merge.hpp
 /// @brief `trivox merge DIR`: joins the shards of a print job into one stack, one VDB and one
 /// manifest, after checking every part.
 ///
@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "trivox/io/manifest.hpp"
+#include "trivox/job/manifest.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 struct MergeSummary {
   int shards = 0;                      ///< N
@@ -43,4 +43,4 @@ MergeSummary merge_job(const std::filesystem::path& dir);
 ///         writing fails
 void merge_vdb_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out);
 
-}  // namespace trivox::io
+}  // namespace trivox::job

@@ -1,4 +1,4 @@
-#include "trivox/io/merge.hpp"
+#include "trivox/job/merge.hpp"
 
 #include <tbb/parallel_for.h>
 
@@ -11,7 +11,7 @@
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_stack.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 namespace fs = std::filesystem;
 
@@ -34,7 +34,7 @@ std::optional<Shard> shard_of_name(const std::string& name) {
 
 bool file_matches(const fs::path& path, const std::string& sha) {
   std::error_code ec;
-  return fs::is_regular_file(path, ec) && sha256_file(path) == sha;
+  return fs::is_regular_file(path, ec) && io::sha256_file(path) == sha;
 }
 
 }  // namespace
@@ -163,25 +163,25 @@ MergeSummary merge_job(const fs::path& dir) {
                 " shards list a VDB part; expected all or none");
 
   if (png) {
-    const StackConfig cfg = stack_config_of(job, sum.material_voxels);
-    const std::string config = config_xml(cfg);
-    write_file_atomically(dir / "ConfigFile.xml", config);
-    merged.files.push_back({"config", "ConfigFile.xml", sha256_hex(config)});
+    const io::StackConfig cfg = stack_config_of(job, sum.material_voxels);
+    const std::string config = io::config_xml(cfg);
+    io::write_file_atomically(dir / "ConfigFile.xml", config);
+    merged.files.push_back({"config", "ConfigFile.xml", io::sha256_hex(config)});
     const auto zip_opt = job.options.find("png.zip");
     if (zip_opt != job.options.end() && zip_opt->second == "yes") {
-      const fs::path zip = gcvf_path(dir);
-      zip_stack(dir, zip);
-      merged.files.push_back({"zip", "../" + zip.filename().string(), sha256_file(zip)});
+      const fs::path zip = io::gcvf_path(dir);
+      io::zip_stack(dir, zip);
+      merged.files.push_back({"zip", "../" + zip.filename().string(), io::sha256_file(zip)});
     }
   }
   if (!vdb_parts.empty()) {
     merge_vdb_parts(vdb_parts, dir / vdb_name);
-    merged.files.push_back({"vdb", vdb_name, sha256_file(dir / vdb_name)});
+    merged.files.push_back({"vdb", vdb_name, io::sha256_file(dir / vdb_name)});
   }
   merged.complete = true;
-  write_file_atomically(dir / merged.shard.manifest_name(), manifest_json(merged));
+  io::write_file_atomically(dir / merged.shard.manifest_name(), manifest_json(merged));
   sum.files = merged.files;
   return sum;
 }
 
-}  // namespace trivox::io
+}  // namespace trivox::job

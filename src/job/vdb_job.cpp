@@ -1,4 +1,4 @@
-#include "trivox/io/vdb_job.hpp"
+#include "trivox/job/vdb_job.hpp"
 
 #include <openvdb/io/Archive.h>
 #include <openvdb/io/Stream.h>
@@ -25,7 +25,7 @@
 
 #include "trivox/error.hpp"
 #include "trivox/geom/quadrature.hpp"
-#include "trivox/io/merge.hpp"
+#include "trivox/job/merge.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/sha256.hpp"
 #include "trivox/slice/locator.hpp"
@@ -33,7 +33,7 @@
 #include "trivox/slice/sampler.hpp"
 #include "trivox/version.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 namespace fs = std::filesystem;
 
@@ -74,7 +74,7 @@ void prepare_folder(const fs::path& dir, bool require_empty, bool force) {
   }
   const fs::path probe = dir / ".trivox-write-test";
   try {
-    write_file_atomically(probe, "");
+    io::write_file_atomically(probe, "");
   } catch (const Error&) {
     throw Error(dir.string() + ": the folder is not writable; expected a writable folder");
   }
@@ -245,8 +245,8 @@ std::pair<std::int64_t, std::string> write_vdb_file(const fs::path& path, const 
                   "OpenVDB 10 file layout", ErrorKind::failed);
   }
   put_uuid(std::string_view(zero_uuid, uuid_size));
-  put_uuid(uuid_from_digest(sha256_file(tmp.path)));
-  const std::string digest = sha256_file(tmp.path);
+  put_uuid(uuid_from_digest(io::sha256_file(tmp.path)));
+  const std::string digest = io::sha256_file(tmp.path);
   const int fd = ::open(tmp.path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0 || ::fsync(fd) != 0) fail("cannot flush the file to disk", errno);
   ::close(fd);
@@ -342,7 +342,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const slice::MaterialMapper mapper(palette, model.properties, opt.palette ? opt.palette->string() : std::string());
   const Layout layout = make_layout(model, palette);
   const std::string model_sha =
-      !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : sha256_file(opt.model_file);
+      !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : io::sha256_file(opt.model_file);
   prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
   openvdb::initialize();
 
@@ -549,7 +549,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   meta.insertMeta("voxel_size", openvdb::DoubleMetadata(vx));
   meta.insertMeta("supersample", openvdb::Int32Metadata(N));
   meta.insertMeta("palette", openvdb::StringMetadata(palette.name));
-  meta.insertMeta("palette_sha256", openvdb::StringMetadata(sha256_hex(slice::palette_json(palette))));
+  meta.insertMeta("palette_sha256", openvdb::StringMetadata(io::sha256_hex(slice::palette_json(palette))));
   meta.insertMeta("colour_source", openvdb::StringMetadata(layout.rgb ? "r,g,b" : "palette"));
 
   openvdb::GridCPtrVec grids;
@@ -614,7 +614,7 @@ void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
     if (p == 0) {
       // OpenVDB hands the grids back sorted by name; the file order (density first) is that of
       // their descriptors, each starting with the name and the type, length-prefixed.
-      const std::string bytes = read_file(parts[p]);
+      const std::string bytes = io::read_file(parts[p]);
       auto position = [&](const openvdb::GridBase::Ptr& g) {
         auto field = [](const std::string& t) {
           const auto n = static_cast<std::uint32_t>(t.size());
@@ -686,4 +686,4 @@ void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
   write_vdb_file(out, out_grids, meta);
 }
 
-}  // namespace trivox::io
+}  // namespace trivox::job

@@ -12,9 +12,9 @@
 #include "trivox/io/model_file.hpp"
 #include "trivox/spline/refine.hpp"
 
-namespace trivox::io::scene_detail {
+namespace trivox::scene::detail {
 
-using namespace json_io;
+using namespace io::json_io;
 using spline::Surface;
 
 namespace {
@@ -81,7 +81,7 @@ void load_gismo(const Source& src, const json& item, const std::string& ptr, Sce
   const std::filesystem::path path = std::filesystem::path(src.name).parent_path() / r.file;
   vmodel::VModel file;
   try {
-    file = read_gismo_xml(read_file(path), path.string());
+    file = io::read_gismo_xml(io::read_file(path), path.string());
   } catch (const Error& e) {
     throw e.within(src.at(gp));
   }
@@ -370,7 +370,7 @@ std::vector<vmodel::VCell> apply_constructor(const Scene& scene, const Source& s
     } else if (op.op == "extrude") {
       cells.push_back({op.name, construct::extrude(in[0], c.vector)});
     } else if (op.op == "revolve") {
-      cells.push_back({op.name, construct::revolve(in[0], c.revolution)});  // seed 003 Sec. 3.2.2 item 3
+      cells.push_back({op.name, construct::revolve(in[0], c.revolution)});  // Massarwi & Elber 2016, Sec. 3.2.2 item 3
     } else {
       cells.push_back({op.name, construct::sweep(in, c.params, c.order)});
     }
@@ -399,4 +399,4 @@ std::vector<vmodel::VCell> apply_constructor(const Scene& scene, const Source& s
   return result;
 }
 
-}  // namespace trivox::io::scene_detail
+}  // namespace trivox::scene::detail

@@ -6,11 +6,12 @@
 #include <string>
 
 #include "trivox/error.hpp"
-#include "trivox/io/manifest.hpp"
-#include "io_test_util.hpp"
+#include "trivox/job/manifest.hpp"
+#include "../io/io_test_util.hpp"
 
 using namespace trivox;
 using namespace trivox::io;
+using namespace trivox::job;
 using trivox::io::test::error_of;
 
 namespace {

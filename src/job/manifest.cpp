@@ -1,4 +1,4 @@
-#include "trivox/io/manifest.hpp"
+#include "trivox/job/manifest.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -10,7 +10,7 @@
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
 
-namespace trivox::io {
+namespace trivox::job {
 
 namespace {
 
@@ -28,7 +28,7 @@ struct Reader {
     throw Error(source + ": " + (ptr.empty() ? std::string("top level") : ptr) + ": " + what);
   }
   [[noreturn]] void fail_type(const std::string& ptr, const json& j, const std::string& expected) const {
-    fail(ptr, "found " + detail::json_describe(j) + "; expected " + expected);
+    fail(ptr, "found " + trivox::detail::json_describe(j) + "; expected " + expected);
   }
   const json& member(const json& obj, const std::string& ptr, const char* key) const {
     const auto it = obj.find(key);
@@ -176,8 +176,8 @@ std::string option_number(double v) {
   return std::string(buf, r.ptr);
 }
 
-StackConfig stack_config_of(const Manifest& m, const std::vector<std::int64_t>& totals) {
-  StackConfig cfg;
+io::StackConfig stack_config_of(const Manifest& m, const std::vector<std::int64_t>& totals) {
+  io::StackConfig cfg;
   cfg.dpi_x = m.dpi_x;
   cfg.dpi_y = m.dpi_y;
   cfg.slice_thickness_nm = m.layer_mm * 1e6;
@@ -221,7 +221,7 @@ std::string manifest_json(const Manifest& m) {
 }
 
 Manifest parse_manifest(std::string_view text, const std::string& source) {
-  const json root = detail::parse_json_text(text, source);
+  const json root = trivox::detail::parse_json_text(text, source);
   const Reader r{source};
   if (!root.is_object()) r.fail_type("", root, "an object {\"trivox_manifest\": 1, ...}");
   const auto& ver = r.member(root, "", "trivox_manifest");
@@ -308,7 +308,7 @@ std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const st
   const auto path = dir / name;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return std::nullopt;
-  return parse_manifest(read_file(path), path.string());
+  return parse_manifest(io::read_file(path), path.string());
 }
 
-}  // namespace trivox::io
+}  // namespace trivox::job
