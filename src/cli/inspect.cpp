@@ -14,7 +14,8 @@
 
 #include "common.hpp"
 #include "trivox/error.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/stack_config.hpp"
+#include "trivox/io/stack_inspect.hpp"
 #include "trivox/io/vdb_inspect.hpp"
 
 namespace trivox::cli {

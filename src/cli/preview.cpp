@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "common.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/preview.hpp"
 
 namespace trivox::cli {
 

@@ -1,8 +1,9 @@
 /// @file src/io/json_io.hpp
-/// @brief Private to io: checked reading of JSON documents and writing of splines, shared by the
-/// model, scene and constructor files. Every value's type and range is checked before it is used, and
-/// every failure is a trivox::Error (bad_input) reading "<file>: <JSON pointer>: <what was
-/// found>; expected <what>" (or "<file>: line L, column C: malformed JSON: ..." for syntax).
+/// @brief Private to trivox_core (io, and scene's reader): checked reading of JSON documents and
+/// writing of splines, shared by the model, scene and constructor files. Every value's type and
+/// range is checked before it is used, and every failure is a trivox::Error (bad_input) reading
+/// "<file>: <JSON pointer>: <what was found>; expected <what>" (or "<file>: line L, column C:
+/// malformed JSON: ..." for syntax).
 #pragma once
 #include <tbb/parallel_for.h>
 #if defined(__SSE2__)

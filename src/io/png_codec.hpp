@@ -1,6 +1,7 @@
 /// @file src/io/png_codec.hpp
-/// @brief (private to src/io) The PNG codec that the module `trivox_png` (src/io/png_plugin/)
-/// provides, and png_codec(), which loads that module the first time a PNG is encoded or decoded.
+/// @brief (private to trivox_core: io, and the slice job) The PNG codec that the module
+/// `trivox_png` (src/io/png_plugin/) provides, and png_codec(), which loads that module the first
+/// time a PNG is encoded or decoded.
 ///
 /// Why a module: Debian's OpenImageIO pulls in about 260 shared libraries (OpenCV, GDAL, DCMTK,
 /// ...), and resolving their symbols cost every trivox command about 0.33 s at start, `trivox

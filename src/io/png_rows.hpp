@@ -1,7 +1,7 @@
 /// @file src/io/png_rows.hpp
-/// @brief (private to src/io) Streaming a slice PNG row by row as 8-bit RGBA, and finding the
-/// slice files of a stack folder. The decoding is the PNG module's (png_codec.hpp), behind the
-/// pimpl.
+/// @brief (private to trivox_core: io, and the slice job) Streaming a slice PNG row by row as 8-bit
+/// RGBA, and finding the slice files of a stack folder. The decoding is the PNG module's
+/// (png_codec.hpp), behind the pimpl.
 #pragma once
 #include <cstdint>
 #include <filesystem>

@@ -1,6 +1,8 @@
 // A picture of a slice stack: contact sheet plus vertical cross-section (write_preview in
-// slice_stack.hpp). Everything is drawn into one RGBA canvas in memory; the stack is read
+// preview.hpp). Everything is drawn into one RGBA canvas in memory; the stack is read
 // streaming, a slice per task.
+#include "trivox/io/preview.hpp"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,7 +12,8 @@
 #include "png_rows.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/png_image.hpp"
+#include "trivox/io/stack_config.hpp"
 
 namespace trivox::io {
 

@@ -1,12 +1,14 @@
 // Reading a slice stack back: which slices are missing or corrupt, and how many voxels of each
-// material the readable ones hold (inspect_stack in slice_stack.hpp).
+// material the readable ones hold (stack_inspect.hpp).
+#include "trivox/io/stack_inspect.hpp"
+
 #include <tbb/parallel_for.h>
 
 #include <climits>
 #include <cstring>
 
 #include "png_rows.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/stack_config.hpp"
 
 namespace trivox::io {
 

@@ -15,7 +15,7 @@
 
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/png_image.hpp"
 
 namespace trivox::io {
 

@@ -1,6 +1,7 @@
-// Voxel Print stacks (io/slice_stack.hpp), checked with independent readers: PNG bytes through
-// OpenImageIO and a hand-parsed chunk list, ConfigFile.xml through pugixml, the .gcvf through
-// libzip. Expected voxel counts come from the pixels the tests write, counted by the test.
+// Voxel Print stacks (io/stack_config.hpp, png_image.hpp, gcvf.hpp, stack_inspect.hpp,
+// preview.hpp), checked with independent readers: PNG bytes through OpenImageIO and a
+// hand-parsed chunk list, ConfigFile.xml through pugixml, the .gcvf through libzip.
+// Expected voxel counts come from the pixels the tests write, counted by the test.
 #include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
 #include <zip.h>
@@ -13,7 +14,11 @@
 
 #include "io_test_util.hpp"
 #include "trivox/io/model_file.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/gcvf.hpp"
+#include "trivox/io/png_image.hpp"
+#include "trivox/io/preview.hpp"
+#include "trivox/io/stack_config.hpp"
+#include "trivox/io/stack_inspect.hpp"
 
 namespace {
 

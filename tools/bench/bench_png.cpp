@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/png_image.hpp"
 
 namespace {
 

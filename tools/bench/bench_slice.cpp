@@ -34,7 +34,8 @@
 
 #include "trivox/io/model_file.hpp"
 #include "trivox/job/slice_job.hpp"
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/png_image.hpp"
+#include "trivox/io/stack_config.hpp"
 #include "trivox/slice/sampler.hpp"
 
 using namespace trivox;

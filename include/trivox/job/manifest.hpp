@@ -24,7 +24,7 @@
 #include <string_view>
 #include <vector>
 
-#include "trivox/io/slice_stack.hpp"
+#include "trivox/io/stack_config.hpp"
 
 namespace trivox::job {
 
