@@ -1,8 +1,8 @@
 /// @file src/scene/scene_construct.hpp
-/// @brief Private to io: the parts of scenes that build cells from surfaces (io/scene.hpp):
+/// @brief Private to scene: the parts of scenes that build cells from surfaces (scene.hpp):
 /// derived scene surfaces ("gismo" patches merged, "offset") and the constructor operations
 /// (ruled, boolean_sum (six faces, or the solid of a tube), half_boolean_sum, extrude, sweep).
-/// scene.cpp calls these from its reader and builder; the messages follow its form,
+/// scene_read.cpp and scene_build.cpp call these; the messages follow their form,
 /// "<file>: <JSON pointer>: <found>; expected <what>".
 #pragma once
 #include <map>
@@ -14,7 +14,7 @@
 
 namespace trivox::scene::detail {
 
-/// Reads the property field at `ptr` (scene.cpp's reader for primitives' fields).
+/// Reads the property field at `ptr` (scene_read.cpp reads primitives' fields with it).
 construct::Field read_field(const io::json_io::Source& src, const io::json_io::json& j, const std::string& ptr,
                             std::size_t properties);
 
