@@ -16,10 +16,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The module's file name and the folder CMake built it in (CMakeLists.txt, trivox_core's
-/// compile definitions).
+/// The module's file name, the folder it is installed in relative to the executable's, and the
+/// folder CMake built it in (CMakeLists.txt, trivox_core's compile definitions).
 #ifndef TRIVOX_PNG_MODULE_NAME
 #define TRIVOX_PNG_MODULE_NAME "libtrivox_png.so"
+#endif
+#ifndef TRIVOX_PNG_MODULE_INSTALL_DIR
+#define TRIVOX_PNG_MODULE_INSTALL_DIR "../lib/trivox"
 #endif
 #ifndef TRIVOX_PNG_MODULE_BUILD_DIR
 #define TRIVOX_PNG_MODULE_BUILD_DIR ""
@@ -32,12 +35,19 @@ std::vector<fs::path> candidate_dirs() {
     dirs.emplace_back(env);  // an override: nothing else is tried
     return dirs;
   }
+  const auto add = [&dirs](const fs::path& dir) {
+    const fs::path normal = dir.lexically_normal();
+    for (const fs::path& d : dirs)
+      if (d == normal) return;
+    dirs.push_back(normal);
+  };
   std::error_code ec;
   const fs::path exe = fs::canonical("/proc/self/exe", ec);
-  if (!ec) dirs.push_back(exe.parent_path());
-  const fs::path built = TRIVOX_PNG_MODULE_BUILD_DIR;
-  if (!built.empty() && (dirs.empty() || built.lexically_normal() != dirs.front().lexically_normal()))
-    dirs.push_back(built);
+  if (!ec) {
+    add(exe.parent_path());                                  // the build folder's layout
+    add(exe.parent_path() / TRIVOX_PNG_MODULE_INSTALL_DIR);  // the installed layout
+  }
+  if (const fs::path built = TRIVOX_PNG_MODULE_BUILD_DIR; !built.empty()) add(built);
   return dirs;
 }
 
@@ -72,7 +82,8 @@ Loaded load() {
   }
   return {nullptr, "cannot load the PNG module " TRIVOX_PNG_MODULE_NAME ": tried " +
                        (tried.empty() ? std::string("no folder") : tried) +
-                       "; expected it next to the trivox executable, or in the folder TRIVOX_PLUGIN_DIR names"};
+                       "; expected it next to the trivox executable, in " TRIVOX_PNG_MODULE_INSTALL_DIR
+                       " from the executable's folder, or in the folder TRIVOX_PLUGIN_DIR names"};
 }
 
 }  // namespace
