@@ -3,13 +3,17 @@
 # Idempotent and quiet: does nothing when all packages are present; uses sudo only when not root.
 set -euo pipefail
 
+# Build: the compiler and tools; Eigen, TBB, nlohmann/json, CLI11, pugixml (G+Smo XML and
+# ConfigFile.xml), libzip (.gcvf), OpenSSL (SHA-256), OpenVDB (with Boost iostreams),
+# OpenImageIO (the PNG module; its CMake package wants OpenCV's headers and its own tools).
+# Tests: Catch2, OpenVDB's tools (vdb_print, vdb_render) and the Python modules of OpenVDB and
+# OpenImageIO as independent readers, unzip for the .gcvf archives.
 packages=(
   build-essential cmake ninja-build pkg-config
-  libeigen3-dev libtbb-dev
-  libopenvdb-dev libboost-iostreams-dev libopenvdb-tools python3-openvdb
-  libopenimageio-dev libopencv-core-dev openimageio-tools python3-openimageio
-  catch2 libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
-  libpugixml-dev libzip-dev zip unzip libssl-dev
+  libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libpugixml-dev libzip-dev libssl-dev
+  libopenvdb-dev libboost-iostreams-dev
+  libopenimageio-dev libopencv-core-dev openimageio-tools
+  catch2 libopenvdb-tools python3-openvdb python3-openimageio unzip
 )
 
 missing=()
