@@ -557,7 +557,7 @@ TEST_CASE("LayerGroupDitherer: each layer of a group equals dithering it alone",
 }
 
 TEST_CASE("fs: dithering leaves the caller's floating-point mode as it found it", "[dither]") {
-  // The fs paths flush subnormal floats while they run (dither.cpp, FlushDenormals); the rest
+  // The fs paths flush subnormal floats while they run (dither_kernels.hpp, FlushDenormals); the rest
   // of the program must still see them. A product below the smallest normal float is
   // subnormal, not 0, after each kind of call.
   const std::vector<std::string> names = {"r", "g", "b"};
