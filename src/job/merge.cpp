@@ -10,6 +10,7 @@
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_stack.hpp"
+#include "trivox/io/vdb_merge.hpp"
 
 namespace trivox::job {
 
@@ -175,7 +176,7 @@ MergeSummary merge_job(const fs::path& dir) {
     }
   }
   if (!vdb_parts.empty()) {
-    merge_vdb_parts(vdb_parts, dir / vdb_name);
+    io::merge_vdb_parts(vdb_parts, dir / vdb_name);
     merged.files.push_back({"vdb", vdb_name, io::sha256_file(dir / vdb_name)});
   }
   merged.complete = true;

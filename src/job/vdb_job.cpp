@@ -1,33 +1,22 @@
 #include "trivox/job/vdb_job.hpp"
 
-#include <openvdb/io/Archive.h>
-#include <openvdb/io/Stream.h>
-#include <openvdb/openvdb.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
-#include <limits>
-#include <map>
 #include <memory>
 #include <system_error>
 
 #include "trivox/error.hpp"
 #include "trivox/geom/quadrature.hpp"
-#include "trivox/job/merge.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/sha256.hpp"
+#include "trivox/io/vdb_volume.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/slice/material.hpp"
 #include "trivox/slice/sampler.hpp"
@@ -39,7 +28,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int leaf_dim = 8;                      // OpenVDB leaf nodes are 8^3 voxels
+constexpr int leaf_dim = io::vdb_leaf_dim;       // the VDB's leaves are 8^3 voxels
 constexpr double max_axis = 1073741824.0;        // 2^30 sub-samples along an axis
 constexpr std::int64_t task_voxels = 1 << 18;    // voxels of one task (dense sums)
 constexpr std::int64_t task_samples = 1 << 22;   // sub-samples of one task
@@ -118,18 +107,41 @@ Layout make_layout(const vmodel::VModel& model, const slice::Palette& palette) {
   return l;
 }
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-using Vec3Leaf = openvdb::Vec3STree::LeafNodeType;
+/// The VDB file's grids and metadata (docs/vdb.md): voxel (i, j, k) centred at origin + (ijk + 1/2)
+/// voxel; one float grid per palette material, then one per other property.
+io::VdbVolumeSpec volume_spec(const vmodel::VModel& model, const VdbPlan& plan, const slice::Palette& palette,
+                              const Layout& layout, const fs::path& model_file, const std::string& model_sha) {
+  const double vx = plan.voxel_mm;
+  io::VdbVolumeSpec spec;
+  spec.voxel_size = vx;
+  spec.first_centre = {plan.origin[0] + vx / 2, plan.origin[1] + vx / 2, plan.origin[2] + vx / 2};
+  spec.metadata = {
+      {"units", std::string("mm")},
+      {"generator", std::string("trivox ") + trivox::version},
+      {"source", model_file.filename().string()},
+      {"source_sha256", model_sha},
+      {"voxel_size", vx},
+      {"supersample", std::int32_t{plan.supersample}},
+      {"palette", palette.name},
+      {"palette_sha256", io::sha256_hex(slice::palette_json(palette))},
+      {"colour_source", std::string(layout.rgb ? "r,g,b" : "palette")},
+  };
+  for (const auto& mat : palette.materials)
+    spec.float_grids.push_back({"material." + mat.name,
+                                {{"material", mat.name},
+                                 {"rgba", std::to_string(mat.rgba[0]) + " " + std::to_string(mat.rgba[1]) + " " +
+                                              std::to_string(mat.rgba[2]) + " " + std::to_string(mat.rgba[3])}}});
+  for (std::size_t e = 0; e < layout.extra_props.size(); ++e)
+    spec.float_grids.push_back(
+        {layout.extra_names[e], {{"property", model.properties[static_cast<std::size_t>(layout.extra_props[e])]}}});
+  return spec;
+}
 
-/// One task's output: its leaves (disjoint from every other task's), per grid in the order made,
-/// and sums. Leaves, not trees: a tree of its own per task and grid would allocate internal
-/// nodes (256 KB and more each) only to free them when merged, and the allocator hands such
-/// blocks back to the system, so that every task's would be faulted in afresh.
+/// One task's output: its leaves (disjoint from every other task's), built in the parallel stage,
+/// and sums.
 struct TaskOut {
-  int index = -1;
-  std::vector<std::unique_ptr<FloatLeaf>> density;
-  std::vector<std::unique_ptr<Vec3Leaf>> color;
-  std::vector<std::vector<std::unique_ptr<FloatLeaf>>> materials, extras;
+  explicit TaskOut(int float_grids) : leaves(float_grids) {}
+  io::VdbLeaves leaves;
   std::int64_t active = 0, fractional = 0, failures = 0, samples = 0;
   double density_sum = 0.0;               // sum of density
   std::vector<double> material_sum;       // sum of fraction x density
@@ -141,126 +153,8 @@ struct Scratch {
   std::vector<std::int32_t> count;   // inside sub-samples per voxel
   std::vector<double> sums;          // per voxel: nprops property sums, then nmat fraction sums
   std::vector<float> fractions;
+  io::VdbLeafValues leaf;            // one leaf's values
 };
-
-/// The random UUID OpenVDB writes into every header, replaced by one derived from the file.
-/// Header: magic (8 bytes), file format (4), library major and minor (4 + 4), grid offsets
-/// flag (1), then the UUID as 36 characters (Archive::writeHeader).
-constexpr std::size_t uuid_offset = 21, uuid_size = 36;
-
-constexpr char zero_uuid[] = "00000000-0000-0000-0000-000000000000";
-
-bool looks_like_uuid(std::string_view u) {
-  if (u.size() != uuid_size) return false;
-  for (std::size_t i = 0; i < uuid_size; ++i) {
-    const bool dash = i == 8 || i == 13 || i == 18 || i == 23;
-    if (dash ? u[i] != '-' : !std::isxdigit(static_cast<unsigned char>(u[i]))) return false;
-  }
-  return true;
-}
-
-/// The first 128 bits of a SHA-256 digest (hex) as an RFC 9562 version 8 (custom) UUID.
-std::string uuid_from_digest(const std::string& h) {
-  std::string u;
-  for (int i = 0; i < 16; ++i) {
-    int byte = std::stoi(h.substr(static_cast<std::size_t>(2 * i), 2), nullptr, 16);
-    if (i == 6) byte = (byte & 0x0f) | 0x80;
-    if (i == 8) byte = (byte & 0x3f) | 0x80;
-    char buf[3];
-    std::snprintf(buf, sizeof buf, "%02x", byte);
-    u += buf;
-    if (i == 3 || i == 5 || i == 7 || i == 9) u += '-';
-  }
-  return u;
-}
-
-/// Archive::write into any seekable stream: what File::write does into its own ofstream.
-class StreamArchive : public openvdb::io::Archive {
-public:
-  void write_to(std::ostream& os, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta) const {
-    Archive::write(os, grids, /*seekable=*/true, meta);
-  }
-};
-
-std::string reason(int err) { return std::strerror(err); }
-
-/// Removes a temporary file unless released.
-struct TempFile {
-  fs::path path;
-  bool keep = false;
-  ~TempFile() {
-    std::error_code ec;
-    if (!keep && !path.empty()) fs::remove(path, ec);
-  }
-};
-
-/// Writes the grids to `path` through a temporary file in the same folder (`.<name>.tmp-<pid>-<n>`):
-/// OpenVDB streams the file there, its random UUID is replaced in place by one derived from the
-/// SHA-256 of the file with the UUID zeroed, then fsync and a rename over `path`. A reader never
-/// sees a partial file; memory stays that of the grids. Returns the size and the SHA-256 of the
-/// written file.
-std::pair<std::int64_t, std::string> write_vdb_file(const fs::path& path, const openvdb::GridCPtrVec& grids,
-                                                    const openvdb::MetaMap& meta) {
-  auto fail = [&](const std::string& what, int err) {
-    throw Error(path.string() + ": " + what + " (" + reason(err) + "); expected a writable folder with room for the file");
-  };
-  TempFile tmp;
-  for (int attempt = 0; attempt < 100 && tmp.path.empty(); ++attempt) {
-    const fs::path name = path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                                                "-" + std::to_string(attempt));
-    const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd >= 0) {
-      ::close(fd);
-      tmp.path = name;
-    } else if (errno != EEXIST) {
-      fail("cannot create a temporary file", errno);
-    }
-  }
-  if (tmp.path.empty()) fail("cannot create a temporary file", EEXIST);
-  {
-    std::ofstream os(tmp.path, std::ios::binary | std::ios::trunc);
-    if (!os) fail("cannot open the temporary file", errno);
-    try {
-      StreamArchive().write_to(os, grids, meta);
-    } catch (const openvdb::Exception& e) {
-      throw Error(path.string() + ": OpenVDB could not write the grids: " + e.what(), ErrorKind::failed);
-    }
-    os.flush();
-    if (!os) fail("writing failed", errno);
-  }
-  // The UUID: zeroed, the file hashed, the derived UUID written in its place.
-  auto put_uuid = [&](std::string_view u) {
-    std::fstream f(tmp.path, std::ios::binary | std::ios::in | std::ios::out);
-    f.seekp(static_cast<std::streamoff>(uuid_offset));
-    f.write(u.data(), static_cast<std::streamsize>(u.size()));
-    f.flush();
-    if (!f) fail("cannot update the file header", errno);
-  };
-  {
-    std::ifstream in(tmp.path, std::ios::binary);
-    std::string head(uuid_offset + uuid_size, '\0');
-    if (!in.read(head.data(), static_cast<std::streamsize>(head.size())) ||
-        !looks_like_uuid(std::string_view(head).substr(uuid_offset)))
-      throw Error(path.string() + ": OpenVDB wrote an unexpected header (no UUID at byte 21); expected the "
-                  "OpenVDB 10 file layout", ErrorKind::failed);
-  }
-  put_uuid(std::string_view(zero_uuid, uuid_size));
-  put_uuid(uuid_from_digest(io::sha256_file(tmp.path)));
-  const std::string digest = io::sha256_file(tmp.path);
-  const int fd = ::open(tmp.path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0 || ::fsync(fd) != 0) fail("cannot flush the file to disk", errno);
-  ::close(fd);
-  if (::rename(tmp.path.c_str(), path.c_str()) != 0) fail("cannot rename the temporary file into place", errno);
-  tmp.keep = true;
-  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
-  std::error_code ec;
-  return {static_cast<std::int64_t>(fs::file_size(path, ec)), digest};
-}
 
 }  // namespace
 
@@ -344,7 +238,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const std::string model_sha =
       !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : io::sha256_file(opt.model_file);
   prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
-  openvdb::initialize();
+  // The grids, filled with the tasks' leaves in task order.
+  io::VdbVolume volume(volume_spec(model, plan, palette, layout, opt.model_file, model_sha));
 
   const int N = plan.supersample;
   const int nx = plan.count[0], ny = plan.count[1], nz = plan.count[2];
@@ -377,8 +272,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   tbb::enumerable_thread_specific<Scratch> scratch;
 
   auto run_task = [&](int t) {
-    TaskOut out;
-    out.index = t;
+    TaskOut out(M + static_cast<int>(layout.extra_props.size()));
     out.material_sum.assign(static_cast<std::size_t>(M), 0.0);
     const int k0 = (slab0 + t / bands) * leaf_dim, k1 = std::min(k0 + leaf_dim, nz);
     const int j0 = (t % bands) * band, j1 = std::min(j0 + band, ny);
@@ -423,10 +317,9 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
     out.samples = static_cast<std::int64_t>(voxels) * n3;
 
     // Leaves, one 8^3 block at a time, every grid with the same active voxels.
-    out.materials.resize(static_cast<std::size_t>(M));
-    out.extras.resize(layout.extra_props.size());
-    std::vector<FloatLeaf*> mat_leaves(static_cast<std::size_t>(M)), extra_leaves(layout.extra_props.size());
+    const int E = static_cast<int>(layout.extra_props.size());
     std::vector<float> mean(static_cast<std::size_t>(channels));
+    io::VdbLeafValues& leaf = s.leaf;
     for (int bj = j0; bj < j1; bj += leaf_dim)
       for (int bi = 0; bi < nx; bi += leaf_dim) {
         const int ei = std::min(bi + leaf_dim, nx), ej = std::min(bj + leaf_dim, j1);
@@ -439,13 +332,9 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
                 break;
               }
         if (!any) continue;
-        const openvdb::Coord origin(bi, bj, k0);
-        auto* dl = out.density.emplace_back(std::make_unique<FloatLeaf>(origin, 0.0f, false)).get();
-        auto* cl = out.color.emplace_back(std::make_unique<Vec3Leaf>(origin, openvdb::Vec3s(0.0f), false)).get();
-        for (std::size_t m = 0; m < mat_leaves.size(); ++m)
-          mat_leaves[m] = out.materials[m].emplace_back(std::make_unique<FloatLeaf>(origin, 0.0f, false)).get();
-        for (std::size_t e = 0; e < extra_leaves.size(); ++e)
-          extra_leaves[e] = out.extras[e].emplace_back(std::make_unique<FloatLeaf>(origin, 0.0f, false)).get();
+        leaf.clear({bi, bj, k0}, M + E);
+        float* const mat_values = leaf.floats.data();
+        float* const extra_values = mat_values + static_cast<std::size_t>(M) * io::vdb_leaf_voxels;
         for (int k = 0; k < nk; ++k)
           for (int j = bj; j < ej; ++j)
             for (int i = bi; i < ei; ++i) {
@@ -459,40 +348,38 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               else
                 for (int h = 0; h < channels; ++h) mean[static_cast<std::size_t>(h)] = static_cast<float>(acc[h] / c);
               const float density = static_cast<float>(c) * inv_n3;
-              const openvdb::Index off = FloatLeaf::coordToOffset(openvdb::Coord(i, j, k0 + k));
-              dl->setValueOn(off, density);
+              const int off = io::VdbLeafValues::offset(i - bi, j - bj, k);
+              const auto at = static_cast<std::size_t>(off);
+              leaf.set_active(off);
+              leaf.density[at] = density;
               ++out.active;
               if (c < n3) ++out.fractional;
               out.density_sum += density;
-              openvdb::Vec3s rgb(0.0f);
+              std::array<float, 3> rgb{0.0f, 0.0f, 0.0f};
               if (layout.rgb) {
                 for (int q = 0; q < 3; ++q)
-                  rgb[q] = std::clamp(mean[static_cast<std::size_t>(layout.rgb_props[static_cast<std::size_t>(q)])], 0.0f, 1.0f);
+                  rgb[static_cast<std::size_t>(q)] =
+                      std::clamp(mean[static_cast<std::size_t>(layout.rgb_props[static_cast<std::size_t>(q)])], 0.0f, 1.0f);
               } else {
                 for (int m = 0; m < M; ++m)
-                  for (int q = 0; q < 3; ++q)
-                    rgb[q] += mean[static_cast<std::size_t>(P + m)] * layout.material_rgb[static_cast<std::size_t>(m)][static_cast<std::size_t>(q)];
-                for (int q = 0; q < 3; ++q) rgb[q] = std::clamp(rgb[q], 0.0f, 1.0f);
+                  for (std::size_t q = 0; q < 3; ++q)
+                    rgb[q] += mean[static_cast<std::size_t>(P + m)] * layout.material_rgb[static_cast<std::size_t>(m)][q];
+                for (float& x : rgb) x = std::clamp(x, 0.0f, 1.0f);
               }
-              cl->setValueOn(off, rgb);
+              for (std::size_t q = 0; q < 3; ++q) leaf.color[3 * at + q] = rgb[q];
               for (int m = 0; m < M; ++m) {
                 const float f = mean[static_cast<std::size_t>(P + m)];
-                mat_leaves[static_cast<std::size_t>(m)]->setValueOn(off, f);
+                mat_values[static_cast<std::size_t>(m) * io::vdb_leaf_voxels + at] = f;
                 out.material_sum[static_cast<std::size_t>(m)] += static_cast<double>(f) * density;
               }
-              for (std::size_t e = 0; e < extra_leaves.size(); ++e)
-                extra_leaves[e]->setValueOn(off, mean[static_cast<std::size_t>(layout.extra_props[e])]);
+              for (int e = 0; e < E; ++e)
+                extra_values[static_cast<std::size_t>(e) * io::vdb_leaf_voxels + at] =
+                    mean[static_cast<std::size_t>(layout.extra_props[static_cast<std::size_t>(e)])];
             }
+        out.leaves.add(leaf);
       }
     return out;
   };
-
-  // The grids, filled with the tasks' leaves in task order.
-  auto density = openvdb::FloatGrid::create(0.0f);
-  auto color = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  std::vector<openvdb::FloatGrid::Ptr> materials, extras;
-  for (int m = 0; m < M; ++m) materials.push_back(openvdb::FloatGrid::create(0.0f));
-  for (std::size_t e = 0; e < layout.extra_props.size(); ++e) extras.push_back(openvdb::FloatGrid::create(0.0f));
 
   VdbJobSummary sum;
   sum.plan = plan;
@@ -514,13 +401,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               tbb::filter_mode::parallel, [&](int t) { return std::make_shared<TaskOut>(run_task(t)); }) &
           tbb::make_filter<std::shared_ptr<TaskOut>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<TaskOut> o) {
             // The grids take the leaves over (each is a new leaf position: tasks are disjoint).
-            auto adopt = [](auto& tree, auto& leaves) {
-              for (auto& l : leaves) tree.addLeaf(l.release());
-            };
-            adopt(density->tree(), o->density);
-            adopt(color->tree(), o->color);
-            for (int m = 0; m < M; ++m) adopt(materials[static_cast<std::size_t>(m)]->tree(), o->materials[static_cast<std::size_t>(m)]);
-            for (std::size_t e = 0; e < extras.size(); ++e) adopt(extras[e]->tree(), o->extras[e]);
+            volume.adopt(o->leaves);
             sum.active_voxels += o->active;
             sum.fractional_voxels += o->fractional;
             sum.inversion_failures += o->failures;
@@ -537,51 +418,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   sum.volume_mm3 = density_sum * voxel_volume;
   for (double& v : sum.material_volume_mm3) v *= voxel_volume;
 
-  // Transform: index (i, j, k) at world origin + (ijk + 1/2) voxel.
-  auto xform = openvdb::math::Transform::createLinearTransform(vx);
-  xform->postTranslate(openvdb::Vec3d(plan.origin[0] + vx / 2, plan.origin[1] + vx / 2, plan.origin[2] + vx / 2));
-
-  openvdb::MetaMap meta;
-  meta.insertMeta("units", openvdb::StringMetadata("mm"));
-  meta.insertMeta("generator", openvdb::StringMetadata(std::string("trivox ") + trivox::version));
-  meta.insertMeta("source", openvdb::StringMetadata(opt.model_file.filename().string()));
-  meta.insertMeta("source_sha256", openvdb::StringMetadata(model_sha));
-  meta.insertMeta("voxel_size", openvdb::DoubleMetadata(vx));
-  meta.insertMeta("supersample", openvdb::Int32Metadata(N));
-  meta.insertMeta("palette", openvdb::StringMetadata(palette.name));
-  meta.insertMeta("palette_sha256", openvdb::StringMetadata(io::sha256_hex(slice::palette_json(palette))));
-  meta.insertMeta("colour_source", openvdb::StringMetadata(layout.rgb ? "r,g,b" : "palette"));
-
-  openvdb::GridCPtrVec grids;
-  auto finish = [&](openvdb::GridBase::Ptr g, const std::string& name) {
-    g->setName(name);
-    g->setTransform(xform->copy());
-    for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it) g->insertMeta(it->first, *it->second);
-    grids.push_back(g);
-    sum.grids.push_back(name);
-  };
-  density->setGridClass(openvdb::GRID_FOG_VOLUME);
-  finish(density, "density");
-  color->setVectorType(openvdb::VEC_INVARIANT);
-  // Cd shares color's tree: OpenVDB writes it once and the second grid as an instance of it
-  // (the reader links them back), so neither the memory nor the file holds the colours twice.
-  auto cd = color->copy();
-  finish(color, "color");
-  finish(cd, "Cd");
-  for (int m = 0; m < M; ++m) {
-    const auto& mat = palette.materials[static_cast<std::size_t>(m)];
-    auto& g = materials[static_cast<std::size_t>(m)];
-    g->insertMeta("material", openvdb::StringMetadata(mat.name));
-    g->insertMeta("rgba", openvdb::StringMetadata(std::to_string(mat.rgba[0]) + " " + std::to_string(mat.rgba[1]) + " " +
-                                                  std::to_string(mat.rgba[2]) + " " + std::to_string(mat.rgba[3])));
-    finish(g, "material." + mat.name);
-  }
-  for (std::size_t e = 0; e < extras.size(); ++e) {
-    extras[e]->insertMeta("property", openvdb::StringMetadata(model.properties[static_cast<std::size_t>(layout.extra_props[e])]));
-    finish(extras[e], layout.extra_names[e]);
-  }
-
-  const auto [bytes, digest] = write_vdb_file(plan.file, grids, meta);
+  const auto [bytes, digest] = volume.write(plan.file);
+  sum.grids = volume.grid_names();
 
   sum.file = plan.file;
   sum.materials.reserve(static_cast<std::size_t>(M));
@@ -592,98 +430,6 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   sum.bytes = bytes;
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sum;
-}
-
-void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
-  if (parts.empty()) throw Error(out.string() + ": no VDB parts to merge; expected at least one");
-  openvdb::initialize();
-  openvdb::GridPtrVec merged;
-  openvdb::MetaMap meta;
-  for (std::size_t p = 0; p < parts.size(); ++p) {
-    openvdb::GridPtrVecPtr grids;
-    openvdb::MetaMap::Ptr file_meta;
-    try {
-      std::ifstream in(parts[p], std::ios::binary);
-      if (!in) throw Error(parts[p].string() + ": cannot open: " + reason(errno) + "; expected a shard's VDB part");
-      openvdb::io::Stream stream(in);
-      grids = stream.getGrids();
-      file_meta = stream.getMetadata();
-    } catch (const openvdb::Exception& e) {
-      throw Error(parts[p].string() + ": cannot read it as a VDB file (" + e.what() + "); expected a shard's VDB part");
-    }
-    if (p == 0) {
-      // OpenVDB hands the grids back sorted by name; the file order (density first) is that of
-      // their descriptors, each starting with the name and the type, length-prefixed.
-      const std::string bytes = io::read_file(parts[p]);
-      auto position = [&](const openvdb::GridBase::Ptr& g) {
-        auto field = [](const std::string& t) {
-          const auto n = static_cast<std::uint32_t>(t.size());
-          std::string f(4, '\0');
-          for (int b = 0; b < 4; ++b) f[static_cast<std::size_t>(b)] = static_cast<char>((n >> (8 * b)) & 0xff);
-          return f + t;
-        };
-        const auto at = bytes.find(field(g->getName()) + field(g->type()));
-        if (at == std::string::npos)
-          throw Error(parts[p].string() + ": grid " + g->getName() + " not found in the file; expected an OpenVDB 10 file");
-        return at;
-      };
-      merged = *grids;
-      std::vector<std::pair<std::size_t, openvdb::GridBase::Ptr>> order;
-      for (auto& g : merged) order.emplace_back(position(g), g);
-      std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-      for (std::size_t g = 0; g < order.size(); ++g) merged[g] = order[g].second;
-      meta = *file_meta;
-      continue;
-    }
-    // The other parts' grids, matched to the first's by name.
-    std::map<std::string, openvdb::GridBase::Ptr> by_name;
-    for (auto& g : *grids) by_name[g->getName()] = g;
-    openvdb::GridPtrVec ordered;
-    for (auto& g : merged) {
-      const auto it = by_name.find(g->getName());
-      if (it == by_name.end())
-        throw Error(parts[p].string() + ": no grid " + g->getName() + "; expected the grids of " + parts[0].string());
-      ordered.push_back(it->second);
-    }
-    *grids = ordered;
-    if (grids->size() != merged.size())
-      throw Error(parts[p].string() + ": " + std::to_string(grids->size()) + " grids; expected " +
-                  std::to_string(merged.size()) + " like " + parts[0].string());
-    std::vector<const void*> trees;  // the trees merged so far (Cd shares color's: merge it once)
-    for (std::size_t g = 0; g < grids->size(); ++g) {
-      auto& into = merged[g];
-      auto& from = (*grids)[g];
-      const void* tree = into->baseTreePtr().get();
-      const bool instance = std::find(trees.begin(), trees.end(), tree) != trees.end();
-      trees.push_back(tree);
-      if (from->getName() != into->getName() || from->type() != into->type() ||
-          from->transform() != into->transform())
-        throw Error(parts[p].string() + ": grid " + std::to_string(g) + " (" + from->getName() + ", " + from->type() +
-                    ") differs from " + parts[0].string() + " (" + into->getName() + ", " + into->type() +
-                    "); expected parts of one job");
-      // The parts hold disjoint whole leaves (shards are whole 8-layer blocks): merging moves
-      // them into the first part's trees.
-      if (instance) continue;
-      if (auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(into)) {
-        f->tree().merge(openvdb::gridPtrCast<openvdb::FloatGrid>(from)->tree());
-      } else if (auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(into)) {
-        v->tree().merge(openvdb::gridPtrCast<openvdb::Vec3SGrid>(from)->tree());
-      } else {
-        throw Error(parts[p].string() + ": grid " + from->getName() + " of type " + from->type() +
-                    "; expected the float and vec3s grids trivox writes");
-      }
-    }
-  }
-  // OpenVDB adds statistics (file_bbox_*, file_voxel_count, ...) to grids it writes and reads
-  // them back as metadata: drop them so they are computed afresh for the merged grids.
-  openvdb::GridCPtrVec out_grids;
-  for (auto& g : merged) {
-    for (const char* stat : {"file_bbox_min", "file_bbox_max", "file_mem_bytes", "file_voxel_count", "file_compression",
-                             "file_delayed_load"})
-      g->removeMeta(stat);
-    out_grids.push_back(g);
-  }
-  write_vdb_file(out, out_grids, meta);
 }
 
 }  // namespace trivox::job

@@ -10,8 +10,8 @@
 /// the .gcvf when the job asked for one, the merged VDB when the parts have VDB parts, and
 /// manifest.json (complete, shard 0 of 1), each written atomically; the parts stay.
 ///
-/// Cost: one SHA-256 pass over every file (parallel), plus the VDB merge (linear in the active
-/// voxels).
+/// Cost: one SHA-256 pass over every file (parallel), plus the VDB merge (io::merge_vdb_parts,
+/// io/vdb_merge.hpp: linear in the active voxels).
 #pragma once
 #include <filesystem>
 #include <string>
@@ -35,12 +35,5 @@ struct MergeSummary {
 ///         shard counts, or missing / unfinished / corrupt shards (the message names each with
 ///         what to rerun); (failed) when writing fails
 MergeSummary merge_job(const std::filesystem::path& dir);
-
-/// Joins VDB files written by the shards of one job (disjoint slabs of whole leaves) into one
-/// file `out` with the same grids, metadata and order; byte-identical to the file an unsharded
-/// job writes. Implemented with OpenVDB in src/io/vdb_merge.cpp.
-/// @throws Error (bad_input) for unreadable parts or parts whose grids differ; (failed) when
-///         writing fails
-void merge_vdb_parts(const std::vector<std::filesystem::path>& parts, const std::filesystem::path& out);
 
 }  // namespace trivox::job

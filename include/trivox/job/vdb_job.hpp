@@ -22,12 +22,13 @@
 ///
 /// How: the model is sampled by slice::LayerSampler on a fine grid of pitch voxel / N (its voxel
 /// centres are the sub-samples), in tasks of whole OpenVDB leaf depth: 8 voxel layers in z by a
-/// band of 8 x b voxel rows in y, all columns. Each task accumulates dense per-voxel sums, then
-/// builds its own trees leaf by leaf (no locks, no shared accessor); a serial stage merges the
-/// tasks' trees in task order. OpenVDB streams the file to a temporary name in the folder; its
-/// random header UUID is replaced in place by one derived from the SHA-256 of the file with the
-/// UUID zeroed; then fsync and a rename: same inputs and options give byte-identical files for
-/// any thread count, and a reader never sees a partial file.
+/// band of 8 x b voxel rows in y, all columns. Each task accumulates dense per-voxel sums, turns
+/// them into the values of its 8^3 leaves and builds their OpenVDB leaf nodes (io::VdbLeaves: no
+/// locks, no shared tree); a serial stage hands the tasks' leaves to the grids in task order
+/// (io::VdbVolume, io/vdb_volume.hpp). The file is streamed to a temporary name in the folder;
+/// its random header UUID is replaced in place by one derived from the SHA-256 of the file with
+/// the UUID zeroed; then fsync and a rename: same inputs and options give byte-identical files
+/// for any thread count, and a reader never sees a partial file.
 ///
 /// Cost: one sampler evaluation per sub-sample inside the model's leaf regions (N^3 per voxel;
 /// void far from the model costs nothing), plus O(properties + materials) per inside sub-sample.
