@@ -445,7 +445,7 @@ TEST_CASE("sampler: the contract holds at printer pitch for overlapping, rationa
   }
   SECTION("the twisted column (the bench's model): its rows' properties from exact samples") {
     // Nearly affine cells with cubic colour fields: the anchors reach across the cells, and
-    // their properties come from the piece's polynomial every few dozen voxels (sampler.cpp).
+    // their properties come from the piece's polynomial every few dozen voxels (run_interpolation.cpp).
     const auto m = io::load_model(models / "twisted_column.json");
     const LayerSampler s(m, thin_grid(m, 2), so);
     CHECK(check_contract(m, s, 3).inside > 300000);
