@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The main job on the default model, the heterogeneous Utah teapot (Masalha et al. 2021, Sec. 8): installs
-# what is missing, builds, turns the scene models/teapot.json (Newell's patches from
+# The main job on the default model, the heterogeneous Utah teapot (Masalha et al. 2021, Sec. 8):
+# installs what is missing, builds, turns the scene models/teapot.json (Newell's patches from
 # models/gismo/teapot.xml, 10 x: 63 x 40 x 31 mm; shells, tube solids, an rgb field per part,
 # fitted fillets body-spout and body-handle) into
 # a model (printing each cell's validity), slices it at GrabCAD J750 settings into output/teapot/ (a Voxel Print PNG
@@ -18,8 +18,8 @@ cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target trivox
 trivox=$build/trivox
 mkdir -p output
 # build prints every cell's validity: the exact det J check for the parts, and for the fillet
-# cells, whose det J vanishes along their rails by construction (Masalha et al. 2021, Sec. 9), the sign of
-# det J sampled inside (docs/fillets.md, "Quality report").
+# cells, whose det J vanishes along their rails by construction (Masalha et al. 2021, Sec. 9), the
+# sign of det J sampled inside (docs/fillets.md, "Quality report").
 "$trivox" build models/teapot.json -o output/teapot.json --force
 echo
 "$trivox" info output/teapot.json

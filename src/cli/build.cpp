@@ -1,10 +1,10 @@
-// `trivox build SCENE -o MODEL`: expands a scene's primitives (Massarwi & Elber 2016, Sec. 3.2.3) and fields
-// into a model, writes it atomically (save_model: a temporary name, then a rename), and prints a
-// quality report: per cell the Jacobian validity bounds and the volume, per primitive the exact
-// volume against the cells' total and how closely the properties follow the field, per fillet
-// (ruled, Masalha et al. 2021, Alg. 2, VBS, Sec. 3.2 / Alg. 3, or V-rep, Sec. 5 / Alg. 6) its gap, C0 glue
-// between its cells, G1 angle, sampled det J sign and property jump (fillet/fillet.hpp). Exit 1 when a cell is not
-// valid (the model is written all the same, so it can be inspected).
+// `trivox build SCENE -o MODEL`: expands a scene's primitives (Massarwi & Elber 2016, Sec. 3.2.3)
+// and fields into a model, writes it atomically (save_model: a temporary name, then a rename), and
+// prints a quality report: per cell the Jacobian validity bounds and the volume, per primitive the
+// exact volume against the cells' total and how closely the properties follow the field, per fillet
+// (ruled, Masalha et al. 2021, Alg. 2, VBS, Sec. 3.2 / Alg. 3, or V-rep, Sec. 5 / Alg. 6) its gap,
+// C0 glue between its cells, G1 angle, sampled det J sign and property jump (fillet/fillet.hpp).
+// Exit 1 when a cell is not valid (the model is written all the same, so it can be inspected).
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -32,12 +32,12 @@ struct Options {
 
 struct CellQuality {
   bool checked = false;  ///< false for a rational trivariate, which check_validity does not decide
-  /// A fillet's half: det J vanishes on the faces that collapse onto the rails (Masalha et al. 2021, Sec. 9),
-  /// so its verdict is the sign of det J inside, from the fillet's own report.
+  /// A fillet's half: det J vanishes on the faces that collapse onto the rails (Masalha et al.
+  /// 2021, Sec. 9), so its verdict is the sign of det J inside, from the fillet's own report.
   const fillet::FilletQuality* fillet = nullptr;
   std::size_t fillet_cell = 0;  ///< its index among the fillet's cells (FilletQuality::cell_jacobian)
-  /// A bridging fillet's half (Masalha et al. 2021, Sec. 6.1): singular on the edge by construction, judged
-  /// the same way from its own report.
+  /// A bridging fillet's half (Masalha et al. 2021, Sec. 6.1): singular on the edge by
+  /// construction, judged the same way from its own report.
   const fillet::CornerQuality* corner = nullptr;
   geom::ValidityReport<3> validity;
   double volume = 0.0;
@@ -71,7 +71,8 @@ nlohmann::ordered_json scene_surfaces(const scene::SceneBuild& built) {
   return out;
 }
 
-/// The constructor operations (Massarwi & Elber 2016, Sec. 3.2.2; construct/tube_solid.hpp for tubes).
+/// The constructor operations (Massarwi & Elber 2016, Sec. 3.2.2;
+/// construct/tube_solid.hpp for tubes).
 nlohmann::ordered_json constructs(const scene::SceneBuild& built) {
   nlohmann::ordered_json out = nlohmann::ordered_json::array();
   for (const auto& c : built.constructs) {
@@ -208,7 +209,8 @@ nlohmann::ordered_json report(const scene::SceneBuild& built, const std::vector<
                   {"min_jacobian", b.quality.det_min},
                   {"max_jacobian", b.quality.det_max},
                   {"seconds", b.seconds}});
-  // Fillets over several faces (Masalha et al. 2021, Sec. 6.1): the bridging fillets at convex corners.
+  // Fillets over several faces (Masalha et al. 2021, Sec. 6.1): the bridging
+  // fillets at convex corners.
   nlohmann::ordered_json jk = nlohmann::ordered_json::array();
   for (const auto& c : built.corners) {
     const auto& q2 = c.quality;
@@ -247,7 +249,8 @@ nlohmann::ordered_json report(const scene::SceneBuild& built, const std::vector<
                            {"glue_before", q2.seam_glue_before},
                            {"property_jump", q2.seam_property_jump}};
   }
-  // Concave corners (Masalha et al. 2021, Sec. 6): the pieces clipped at the rails' crossing and stitched.
+  // Concave corners (Masalha et al. 2021, Sec. 6): the pieces clipped at the
+  // rails' crossing and stitched.
   nlohmann::ordered_json js = nlohmann::ordered_json::array();
   for (const auto& st : built.stitches) {
     const auto& jn = st.junction;
@@ -328,7 +331,8 @@ void print_human(const nlohmann::ordered_json& j) {
                   f["jacobian"].get<std::string>().c_str(), c0 && c1 ? "composed" : (c0 || c1 ? "mixed" : "fitted"),
                   fmt(f["seconds"].get<double>(), 3).c_str());
     }
-    // V-rep fillets (Masalha et al. 2021, Alg. 6): the trimmed cell is T_hbs less the solid beyond S_b.
+    // V-rep fillets (Masalha et al. 2021, Alg. 6): the trimmed cell is T_hbs
+    // less the solid beyond S_b.
     for (const auto& f : j["fillets"]) {
       if (f["vrep"].is_null()) continue;
       const auto& v = f["vrep"];

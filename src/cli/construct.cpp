@@ -1,6 +1,6 @@
 // `trivox construct INPUT`: one constructor (Boolean sum, half Boolean sum, ruling, extrusion,
-// revolution, sweep) on given curves or surfaces, regular or kernel-based (Fadila et al. 2023, Alg. 1),
-// with its Jacobian validity. Exit 1 when the result is not a valid parametrisation (then -o
+// revolution, sweep) on given curves or surfaces, regular or kernel-based (Fadila et al. 2023, Alg.
+// 1), with its Jacobian validity. Exit 1 when the result is not a valid parametrisation (then -o
 // writes nothing unless --keep-invalid).
 #include <algorithm>
 #include <cmath>

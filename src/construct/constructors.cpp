@@ -496,7 +496,8 @@ Trivariate half_boolean_sum(const Surface& s1_in, const Surface& s2_in, const Su
   std::vector<double> P(p1.size());
   for (std::size_t i = 0; i < P.size(); ++i)
     P[i] = p1[i] == p2[i] && p2[i] == p3[i] ? p1[i] : (p1[i] + p2[i] + p3[i]) / 3.0;
-  // T = s1(u,v) + s2(v,w) + s3(u,w) - (C1(u) + C2(v) + C3(w)) + P: Fadila et al. 2023, Sec. 3.2, Lemma 3.
+  // T = s1(u,v) + s2(v,w) + s3(u,w) - (C1(u) + C2(v) + C3(w)) + P: Fadila et
+  // al. 2023, Sec. 3.2, Lemma 3.
   Trivariate T = spline::add(extend_constant<3>(s1, 2), extend_constant<3>(s2, 0));
   T = spline::add(T, extend_constant<3>(s3, 1));
   T = spline::add(T, extend_constant<3>(extend_constant<2>(C1, 1), 2), -1.0);

@@ -218,8 +218,8 @@ void quarter_turns(double& x, double& y, int q) {
   }
 }
 
-/// core, then the outer parts at quarter turns q = 0 (+x), 1 (+y), 2 (-x), 3 (-y) (Massarwi & Elber 2016
-/// Fig. 9 (a)): the square [-0.5, 0.5]^2 in the arc's space in both directions, and each outer
+/// core, then the outer parts at quarter turns q = 0 (+x), 1 (+y), 2 (-x), 3 (-y) (Massarwi & Elber
+/// 2016 Fig. 9 (a)): the square [-0.5, 0.5]^2 in the arc's space in both directions, and each outer
 /// part ruled (u) from the square's side to the arc, v counter-clockwise.
 std::array<Patch2, 5> disk_pattern(const Arc& arc) {
   const int n = arc.knots.size();

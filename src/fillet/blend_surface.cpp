@@ -162,7 +162,8 @@ Surface blending_surface(const BlendInput& in, const BlendOptions& o, BlendRepor
   KnotVector across;
 
   if (o.section == Section::hermite) {
-    // Masalha et al. 2021, Sec. 1.3: T_i = C_i^r' x N_i(c_i^r), normalised, scaled by tau |C_1 - C_2|.
+    // Masalha et al. 2021, Sec. 1.3: T_i = C_i^r' x N_i(c_i^r), normalised,
+    // scaled by tau |C_1 - C_2|.
     std::array<Curve, 2> field;
     for (int i = 0; i < 2; ++i) {
       const Surface& face = *in.faces[static_cast<std::size_t>(i)];

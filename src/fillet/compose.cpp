@@ -165,8 +165,8 @@ double xyz_distance(const double* a, const double* b, int dim) {
   return std::sqrt(s);
 }
 
-/// Masalha et al. 2021, Sec. 4.3: the sub-region as a least-squares surface of samples of s(r), with the
-/// boundary rows v = 0 and v = 1 pinned to least-squares curves of s(from) and s(to).
+/// Masalha et al. 2021, Sec. 4.3: the sub-region as a least-squares surface of samples of s(r),
+/// with the boundary rows v = 0 and v = 1 pinned to least-squares curves of s(from) and s(to).
 Surface fit_subregion(const Surface& s, const Surface& r, const SubregionOptions& o, double& error) {
   const int dim = s.dim();
   // u: cubic on the curves' breakpoints; v: a cubic Bezier, then halved with u.

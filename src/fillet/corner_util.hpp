@@ -56,8 +56,8 @@ void pin_end(std::span<spline::Trivariate> cells, int gs, spline::Face end, std:
 /// converge inside both domains.
 bool rails_cross(const spline::Curve& ra, const spline::Curve& rb, double& s, double& t);
 
-/// Masalha et al. 2021, Sec. 6, the concave corner: a ruled fillet half clipped by the stitch plane Pi
-/// (through o, n its normal): each of its faces w = 0 (on S^_i) and w = 1 (on S_b) becomes
+/// Masalha et al. 2021, Sec. 6, the concave corner: a ruled fillet half clipped by the stitch plane
+/// Pi (through o, n its normal): each of its faces w = 0 (on S^_i) and w = 1 (on S_b) becomes
 /// F(u(s, v), v), u running from where F's v-iso crosses Pi (a(v), interpolated at the Greville
 /// points of a cubic space, spans doubled until F(a(v), v) is within tol of Pi) to the far end
 /// (fillet/compose.hpp's sub-region with the ruled map between (a(v), v) and (u_far, v):

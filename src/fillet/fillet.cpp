@@ -321,8 +321,9 @@ std::vector<Fillet> fillet_faces(const Trivariate& cell1, Face f1, const Trivari
     so.method = o.method;  // subregion() composes for `matched` (only the whole curve lands there)
     so.tolerance = tol;
     // The sub-regions and blending inputs: one pair over the whole curve, or, for B-spline faces
-    // whose knot lines C crosses, one matched Bezier pair per piece (Masalha et al. 2021, Alg. 4-5), each
-    // composed exactly; "auto" falls back to fitting (Sec. 4.3) when Lemma 1's condition fails.
+    // whose knot lines C crosses, one matched Bezier pair per piece (Masalha et al. 2021, Alg.
+    // 4-5), each composed exactly; "auto" falls back to fitting (Sec. 4.3) when
+    // Lemma 1's condition fails.
     struct Part {
       Surface sub1, sub2;
       BlendInput in;

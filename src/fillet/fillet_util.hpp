@@ -219,9 +219,9 @@ inline std::vector<double> u_samples(const spline::Trivariate& t) {
   return out;
 }
 
-/// det J sampled inside a cell (not bounded: fillet cells' det J vanishes on their rails, Masalha et al. 2021
-/// Sec. 9, where geom::check_validity chases it): at u_samples along u times n1 x n2 midpoints
-/// across. Returns {min, max}.
+/// det J sampled inside a cell (not bounded: fillet cells' det J vanishes on their rails, Masalha
+/// et al. 2021 Sec. 9, where geom::check_validity chases it): at u_samples along u times n1 x n2
+/// midpoints across. Returns {min, max}.
 inline std::array<double, 2> sampled_jacobian(const spline::Trivariate& h, int n1 = 6, int n2 = 4) {
   std::array<double, 2> range{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   const auto dv = h.domain(1), dw = h.domain(2);

@@ -1,7 +1,7 @@
 /// @file src/fillet/property_blend.hpp
 /// @brief Internal: the inputs of a volumetric fillet (S^_1, S^_2, S_b) checked and brought into
-/// one function space, S_b given the property function g_b of Masalha et al. 2021, Sec. 7.1, and the two
-/// copies of C (S^_1(u, 1), S^_2(u, 0)) joined into one curve. Shared by the ruled fillet
+/// one function space, S_b given the property function g_b of Masalha et al. 2021, Sec. 7.1, and
+/// the two copies of C (S^_1(u, 1), S^_2(u, 0)) joined into one curve. Shared by the ruled fillet
 /// (Alg. 2) and the volumetric-Boolean-sum fillet (Alg. 3).
 #pragma once
 #include <algorithm>
@@ -55,7 +55,8 @@ inline std::array<spline::Surface, 3> fillet_common_space(const spline::Surface&
   Surface &s1 = c[0], &s2 = c[1], &b = c[2];
   const int nu = b.count(0), nv = b.count(1);
   if (blend_properties) {
-    // Masalha et al. 2021, Sec. 7.1: g_b = sum ((1 - a_r) p1_{m,r} + a_r p2_{m,r}) B_{m,r}, a_r = r / (n_v - 1).
+    // Masalha et al. 2021, Sec. 7.1: g_b = sum ((1 - a_r) p1_{m,r} + a_r p2_{m,r})
+    // B_{m,r}, a_r = r / (n_v - 1).
     for (int r = 0; r < nv; ++r) {
       const double a = nv > 1 ? static_cast<double>(r) / (nv - 1) : 0.0;
       for (int m = 0; m < nu; ++m) {

@@ -36,8 +36,8 @@ const vmodel::VCell& find_cell(const Source& src, const Objects& objects, const 
                 "<name>.<part>)");
 }
 
-/// Masalha et al. 2021, Sec. 6 / 6.1: the fillet over several faces (fillet/corners.hpp): its pieces' cells
-/// <name>.<k>a, <name>.<k>b in chain order, the bridges' <name>.c<j>a, <name>.c<j>b.
+/// Masalha et al. 2021, Sec. 6 / 6.1: the fillet over several faces (fillet/corners.hpp): its
+/// pieces' cells <name>.<k>a, <name>.<k>b in chain order, the bridges' <name>.c<j>a, <name>.c<j>b.
 template <class Objects>
 std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOperation& op, const Objects& objects,
                                                SceneBuild& out) {
@@ -122,10 +122,10 @@ std::vector<vmodel::VCell> apply_fillet_across(const Source& src, const SceneOpe
   return cells;
 }
 
-/// Masalha et al. 2021, Alg. 2 (or Sec. 3.2 / Alg. 3 with "construction": "vbs", Sec. 5 / Alg. 6 with
-/// "vrep") between two cells: the faces (given, or the one intersecting pair), the fillets, their
-/// cells named <name>.<k>a and <name>.<k>b (vbs: <name>.<k>.1, .2, .3; vrep: the trimmed cell
-/// <name>.<k>).
+/// Masalha et al. 2021, Alg. 2 (or Sec. 3.2 / Alg. 3 with "construction": "vbs", Sec. 5 / Alg. 6
+/// with "vrep") between two cells: the faces (given, or the one intersecting pair), the fillets,
+/// their cells named <name>.<k>a and <name>.<k>b (vbs: <name>.<k>.1, .2, .3; vrep: the
+/// trimmed cell <name>.<k>).
 template <class Objects>
 std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation& op,
                                         const Objects& objects, SceneBuild& out) {
@@ -235,8 +235,8 @@ std::vector<vmodel::VCell> apply_fillet(const Source& src, const SceneOperation&
       for (std::size_t c = 0; c < names.size(); ++c) cells.push_back(fillets[k].vcell(c, names[c]));
       continue;
     }
-    // Masalha et al. 2021, Sec. 7.2: both halves carry f, encoded, and S^_1, S^_2 (their faces w = 0) for
-    // the exact per-voxel value.
+    // Masalha et al. 2021, Sec. 7.2: both halves carry f, encoded, and S^_1, S^_2 (their faces w =
+    // 0) for the exact per-voxel value.
     vmodel::ShepardData sd;
     sd.power = op.shepard_power;
     for (std::size_t h = 0; h < 2; ++h) sd.sources[h] = spline::boundary_face(fillets[k].cells[h], spline::Face::w0);

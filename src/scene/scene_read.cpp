@@ -230,7 +230,8 @@ void read_fillet(const Source& src, const json& item, const std::string& ip, Sce
   };
   o.across = between[0].is_array() || between[1].is_array();
   if (o.across) {
-    // Masalha et al. 2021, Sec. 6: every listed face of one side against every listed face of the other.
+    // Masalha et al. 2021, Sec. 6: every listed face of one side against every
+    // listed face of the other.
     for (std::size_t i = 0; i < 2; ++i) {
       const std::string ep = child(bp, i);
       const json& e = between[i];

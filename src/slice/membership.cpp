@@ -83,9 +83,9 @@ bool Locator::admits(int cell, const Vec3& p, double* props) const {
   }
   if (!blend) return true;
   const std::size_t n = values.size() / static_cast<std::size_t>(m);
-  // Weights: 1 for the sum and the mean; Massarwi & Elber 2016, Eq. 2's d_i^k for the distance blend, d_i the
-  // distance to input i's boundary (on every input's boundary at once, Eq. 2's singular points,
-  // the plain mean).
+  // Weights: 1 for the sum and the mean; Massarwi & Elber 2016, Eq. 2's d_i^k for the distance
+  // blend, d_i the distance to input i's boundary (on every input's boundary at once, Eq. 2's
+  // singular points, the plain mean).
   std::vector<double> w(n, 1.0);
   if (trim->blend == vmodel::BlendRule::distance) {
     double wsum = 0.0;

@@ -78,7 +78,8 @@ std::vector<spline::Surface> boundary_of(const VModel& m) {
 }
 
 /// Where the faces of `others` (those whose boxes meet home's) cut home's six faces: curves in
-/// each face's parameters (Massarwi & Elber 2016, Sec. 4: the trimming curves of the boundary V-surfaces).
+/// each face's parameters (Massarwi & Elber 2016, Sec. 4: the trimming curves of
+/// the boundary V-surfaces).
 std::vector<FaceTrim> cut_faces(const VCell& home, const std::vector<VCell>& others, const std::vector<Box>& boxes,
                                 double tolerance) {
   const Box hb = region_box(home);

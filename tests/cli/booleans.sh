@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
-# End-to-end: Booleans in scenes (`trivox build` with union / intersection / subtraction; Massarwi & Elber 2016
-# Sec. 4). Truths: a ball of radius 10 less the half-space box x >= 0 is a half ball,
+# End-to-end: Booleans in scenes (`trivox build` with union / intersection / subtraction; Massarwi &
+# Elber 2016 Sec. 4). Truths: a ball of radius 10 less the half-space box x >= 0 is a half ball,
 # 2/3 pi 10^3 = 2094.395 mm^3 (info's sampled volume and the printed voxel count agree within
-# 1 percent); locate says inside / outside by the sign of x; the union of two boxes of Massarwi & Elber 2016
-# Fig. 3 has its topology counts (3 cells, 16 V-surfaces, 18 half-V-surfaces, 28 V-curves,
-# 16 V-points) and a voxel count equal to its 3 unit-cube volume; where two inputs overlap a
-# sum_clip blend gives the sum of their values; bad operands exit 2 naming the place.
+# 1 percent); locate says inside / outside by the sign of x; the union of two boxes of Massarwi &
+# Elber 2016 Fig. 3 has its topology counts (3 cells, 16 V-surfaces, 18 half-V-surfaces, 28
+# V-curves, 16 V-points) and a voxel count equal to its 3 unit-cube volume; where two inputs overlap
+# a sum_clip blend gives the sum of their values; bad operands exit 2 naming the place.
 set -euo pipefail
 source tests/cli/lib.bash "$@"
 

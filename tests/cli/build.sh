@@ -2,9 +2,9 @@
 # End-to-end: `trivox build` (io/scene.hpp, construct/primitives.hpp). Truths: the analytic volumes
 # of the five primitives of models/primitives.json (box 16 x 12 x 8; cylinder pi 6^2 14; frustum
 # pi 12 (7^2 + 7 3 + 3^2) / 3; torus 2 pi^2 8 3^2; ball 4/3 pi 8^3), computed here in Python;
-# their cell counts (1, 5, 5, 5, 7) and topology (22 + 22 + 22 + 24 + 6 V-surfaces, Massarwi & Elber 2016
-# Fig. 9; see tests/construct/test_primitives.cpp); a coarse slice's voxel count times the voxel
-# volume is the total volume up to the voxelisation of the surface (3 percent at 35 dpi).
+# their cell counts (1, 5, 5, 5, 7) and topology (22 + 22 + 22 + 24 + 6 V-surfaces, Massarwi & Elber
+# 2016 Fig. 9; see tests/construct/test_primitives.cpp); a coarse slice's voxel count times the
+# voxel volume is the total volume up to the voxelisation of the surface (3 percent at 35 dpi).
 set -euo pipefail
 source tests/cli/lib.bash "$@"
 
@@ -77,9 +77,9 @@ expect_fail '/operations/0/op: unknown operation "smooth"; expected one of "unio
 # A scene is refused by commands that need a model, with the hint.
 expect_fail "trivox build SCENE -o MODEL" "$trivox" info models/primitives.json
 
-# revolve (Massarwi & Elber 2016, Sec. 3.2.2 item 3): the rectangle r in [2, 3], z in [0, 1] in the xz-plane
-# turned about z by 360 degrees (and by 90) is the annulus of volume pi (3^2 - 2^2) (a quarter of
-# it), within the revolution's tolerance (relative 1e-6 of the radius: volume error below
+# revolve (Massarwi & Elber 2016, Sec. 3.2.2 item 3): the rectangle r in [2, 3], z in [0, 1] in the
+# xz-plane turned about z by 360 degrees (and by 90) is the annulus of volume pi (3^2 - 2^2) (a
+# quarter of it), within the revolution's tolerance (relative 1e-6 of the radius: volume error below
 # 3 x 1e-6 relative); every cell valid; bad angles exit 2.
 revolve_scene() {
   printf '{"trivox": 1, "properties": ["d"], "surfaces": [{"name": "rect", "surface": {"orders": [2, 2], "knots": [[0, 0, 1, 1], [0, 0, 1, 1]], "points": [[2, 0, 0, 5], [3, 0, 0, 5], [2, 0, 1, 5], [3, 0, 1, 5]]}}], "operations": [{"op": "revolve", "name": "ring", "surfaces": ["rect"], "axis": [0, 0, 1]%s}]}' "$1" > "$tmp/rev.json"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# End-to-end: fillets over several faces with C1 corners (Masalha et al. 2021, Sec. 6) and the singular
-# bridging fillets at the convex corners (Sec. 6.1), built by `trivox build`. Truths:
+# End-to-end: fillets over several faces with C1 corners (Masalha et al. 2021, Sec. 6) and the
+# singular bridging fillets at the convex corners (Sec. 6.1), built by `trivox build`. Truths:
 # - a column [-1,1]^2 x [-1,3] through a plate z <= 0 (boxes): C is the square footprint, four
 #   straight pieces and four convex corners at the column's vertical edges. The pieces are the
 #   Hermite section swept along 2 mm each, the bridges the section turned a quarter turn about the

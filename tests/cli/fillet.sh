@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# End-to-end: the scene operation "fillet" (Masalha et al. 2021, Alg. 2, Sec. 7.1; Flends Sec. II) built by
-# `trivox build` and seen by `trivox locate`. Truths: between a floor z <= 0 and a wall x <= 2
-# (boxes, faces chosen), the dip-0 flend is the chamfer, a prism of volume d1 d2 / 2 times the
+# End-to-end: the scene operation "fillet" (Masalha et al. 2021, Alg. 2, Sec. 7.1; Flends Sec. II)
+# built by `trivox build` and seen by `trivox locate`. Truths: between a floor z <= 0 and a wall x
+# <= 2 (boxes, faces chosen), the dip-0 flend is the chamfer, a prism of volume d1 d2 / 2 times the
 # length 4; the Hermite fillet's volume is 4 times the area its section (a cubic with known
 # control points) cuts from the corner, by Green's theorem in numpy; both meet the faces with no
 # gap, G1 below 1e-6 rad, det J > 0 inside, and carry each box's colour on its face. Points just

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# End-to-end: fillets between B-spline faces as matched Bezier pairs (Masalha et al. 2021, Sec. 4.1-4.2,
-# Alg. 4-5; fillet/matched.hpp). A plane (the top of a disk's core cell) meets a cylinder's
+# End-to-end: fillets between B-spline faces as matched Bezier pairs (Masalha et al. 2021, Sec.
+# 4.1-4.2, Alg. 4-5; fillet/matched.hpp). A plane (the top of a disk's core cell) meets a cylinder's
 # quarter (a rod's side cell): both faces are B-splines whose knot lines the intersection
 # crosses (Fig. 7's case). With "method": "matched":
 # - the fillet comes as several pieces, each composed exactly (no fitting): its faces lie on

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# End-to-end: fillets with the Shepard blend (Masalha et al. 2021, Sec. 7.2; fillet/shepard.hpp). A floor
-# z <= 0 (red) and a wall x <= 2 (blue), filleted with "blend": "shepard", "power": 3: the
+# End-to-end: fillets with the Shepard blend (Masalha et al. 2021, Sec. 7.2; fillet/shepard.hpp). A
+# floor z <= 0 (red) and a wall x <= 2 (blue), filleted with "blend": "shepard", "power": 3: the
 # sub-regions are the planar strips S^_1 = {z = 0, 2 <= x <= 3} and S^_2 = {x = 2, 0 <= z <= 0.5},
 # so inside the fillet d_1 = z, d_2 = x - 2 and f is analytic (numpy, independently):
 # alpha_floor = z^-q / (z^-q + (x - 2)^-q), rgb = (alpha_floor, 0, 1 - alpha_floor).

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# End-to-end: the scene fillet with "construction": "vbs" (Masalha et al. 2021, Sec. 3.2, Alg. 3, Appendix A)
-# built by `trivox build`, read back by `trivox info` and `trivox locate`. Truths:
+# End-to-end: the scene fillet with "construction": "vbs" (Masalha et al. 2021, Sec. 3.2, Alg. 3,
+# Appendix A) built by `trivox build`, read back by `trivox info` and `trivox locate`. Truths:
 # - between a floor z <= 0 and a wall x <= 2 (boxes), the Hermite VBS fillet fills the region
 #   between the faces and the cubic section: 4 times the area by Green's theorem (numpy), as the
 #   ruled fillet does; its three cells meet S^_1, S^_2 and S_b with no gap, G1 below 1e-6 rad,

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# End-to-end: the scene fillet with "construction": "vrep" (Masalha et al. 2021, Sec. 5, Def. 5.1, Alg. 6:
-# the half volumetric Boolean sum trimmed by S^_1, S^_2, S_b and the caps) built by `trivox build`,
-# read back by `trivox locate` and sliced by `trivox slice`. Truths:
+# End-to-end: the scene fillet with "construction": "vrep" (Masalha et al. 2021, Sec. 5, Def. 5.1,
+# Alg. 6: the half volumetric Boolean sum trimmed by S^_1, S^_2, S_b and the caps) built by `trivox
+# build`, read back by `trivox locate` and sliced by `trivox slice`. Truths:
 # - between a floor z <= 0 and a wall x <= 2 (boxes), the trimmed cell is the region between the
 #   faces and the Hermite section: 4 times its area by Green's theorem (numpy), the ruled
 #   fillet's volume; its faces lie on S^_1, S^_2, S_b (gap 0), G1 at the rails, det J of T_hbs

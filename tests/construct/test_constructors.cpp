@@ -1,9 +1,9 @@
 // Constructors (construct/constructors.hpp). Truths: each constructor's closed formula evaluated
 // independently from its inputs at random parameters (ruling, extrusion, Coons patch and volume,
-// half Boolean sums of Fadila et al. 2023, Sec. 3); the boundary interpolation of Fadila et al. 2023 Lemmas 1-3; a
-// sweep reproduces a trivariate that is cubic in w from four of its sections; revolution
-// follows the exact rotation within the stated tolerance and gives the analytic volume of a
-// solid of revolution (Pappus).
+// half Boolean sums of Fadila et al. 2023, Sec. 3); the boundary interpolation of Fadila et al.
+// 2023 Lemmas 1-3; a sweep reproduces a trivariate that is cubic in w from four of its sections;
+// revolution follows the exact rotation within the stated tolerance and gives the analytic volume
+// of a solid of revolution (Pappus).
 #include <catch2/catch.hpp>
 
 #include <cmath>

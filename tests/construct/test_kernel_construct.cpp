@@ -1,5 +1,5 @@
-// Kernel-based constructors (construct/kernel_construct.hpp, Fadila et al. 2023, Alg. 1). Truths, checked
-// independently of the code under test: det J from first partials on dense grids (its sign
+// Kernel-based constructors (construct/kernel_construct.hpp, Fadila et al. 2023, Alg. 1). Truths,
+// checked independently of the code under test: det J from first partials on dense grids (its sign
 // shows the regular construction invalid and the kernel-based one valid), the boundaries equal
 // the inputs (Fadila et al. 2023 Lemmas 1-3, kept because only interior control points move), the
 // interior control points sit at the kernel centroid, properties stay as the regular
@@ -69,8 +69,8 @@ double boundary_gap(const Surface& s, int dir, double at, const Curve& c) {
   return gap;
 }
 
-/// Boolean sum inputs [bottom, top, left, right] from the Fadila et al. 2023, Sec. 5.1 generator (inner
-/// control points rounded): the Coons patch folds, the boundary is star-shaped.
+/// Boolean sum inputs [bottom, top, left, right] from the Fadila et al. 2023, Sec. 5.1 generator
+/// (inner control points rounded): the Coons patch folds, the boundary is star-shaped.
 std::vector<Curve> folded_coons() {
   return {cubic({{-1, -1}, {-0.08, -1.42}, {1.13, -1.37}, {1, -1}}), cubic({{-1, 1}, {0.61, 1.22}, {0.14, 0.99}, {1, 1}}),
           cubic({{-1, -1}, {-0.52, 0.36}, {-1.11, 0.67}, {-1, 1}}), cubic({{1, -1}, {0.69, -0.19}, {1.29, -0.26}, {1, 1}})};

@@ -1,6 +1,6 @@
-// Non-singular primitives (construct/primitives.hpp, Massarwi & Elber 2016, Sec. 3.2.3). Truths: the analytic
-// volumes (box product, pi r^2 h, the frustum pi h (r^2 + r r_t + r_t^2) / 3, 2 pi^2 R r^2,
-// 4/3 pi r^3) against Gauss quadrature of det J (exact for polynomial cells); the distance of
+// Non-singular primitives (construct/primitives.hpp, Massarwi & Elber 2016, Sec. 3.2.3). Truths:
+// the analytic volumes (box product, pi r^2 h, the frustum pi h (r^2 + r r_t + r_t^2) / 3, 2 pi^2 R
+// r^2, 4/3 pi r^3) against Gauss quadrature of det J (exact for polynomial cells); the distance of
 // densely sampled boundary points from the exact surface; det J > 0 by Bezier bounds
 // (geom::check_validity); the topology counts of the complexes, derived by hand (and checked by
 // Euler's formula V - E + F - C = 1 for a ball); shared faces holding identical control points;

@@ -1,8 +1,8 @@
-// Flends between disjoint bodies (Eager & Dannenhoffer 2019, Sec. III), volumetric: the bridge between two faces.
-// Truths: between aligned boxes the bridge is the box between them (volume 1 for any dip); with
-// the second box lifted by 1 the end lines are parallel and the section's bottom and top edges
-// are translates, so the cross-section has area 1 x 2 (volume 2); the bridge's end faces are
-// the cells' faces point for point, its w-direction there is the cells' own (G1), properties
+// Flends between disjoint bodies (Eager & Dannenhoffer 2019, Sec. III), volumetric: the bridge
+// between two faces. Truths: between aligned boxes the bridge is the box between them (volume 1 for
+// any dip); with the second box lifted by 1 the end lines are parallel and the section's bottom and
+// top edges are translates, so the cross-section has area 1 x 2 (volume 2); the bridge's end faces
+// are the cells' faces point for point, its w-direction there is the cells' own (G1), properties
 // run from one cell's to the other's.
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
-// Masalha et al. 2021, Sec. 6 / 6.1 (fillet/corners.hpp): a column standing through a plate. C is the
-// column's square footprint, four straight pieces C_{w1,j} meeting at four convex corners where
+// Masalha et al. 2021, Sec. 6 / 6.1 (fillet/corners.hpp): a column standing through a plate. C is
+// the column's square footprint, four straight pieces C_{w1,j} meeting at four convex corners where
 // the column's vertical edges (perpendicular to the plate) cross the plate. Expected values from
 // the geometry: the column's rails meet on its edges at r = o + d2 z, the plate's rails end at
 // distance d1 from o; each piece's fillet is the Hermite section swept along a straight line of

@@ -1,7 +1,8 @@
-// The fillet's building blocks: composition (Masalha et al. 2021, Sec. 1.5), blending surfaces (Alg. 1 and
-// the flend section, Eager & Dannenhoffer 2019, Sec. II.A), the ruled-volume fillet with parametric property
-// blending (Alg. 2, Sec. 7.1). Expected values are exact: pointwise composition, the chamfer
-// plane, tangent planes of planes, Green's-theorem areas of the Hermite section.
+// The fillet's building blocks: composition (Masalha et al. 2021, Sec. 1.5), blending surfaces
+// (Alg. 1 and the flend section, Eager & Dannenhoffer 2019, Sec. II.A), the ruled-volume fillet
+// with parametric property blending (Alg. 2, Sec. 7.1). Expected values are exact: pointwise
+// composition, the chamfer plane, tangent planes of planes, Green's-theorem
+// areas of the Hermite section.
 #include <catch2/catch.hpp>
 
 #include <cmath>

@@ -1,5 +1,5 @@
-// Shepard (Euclidean-distance) property blending of fillets (fillet/shepard.hpp; Masalha et al. 2021
-// Sec. 7.2). Truths, from the mathematics alone:
+// Shepard (Euclidean-distance) property blending of fillets (fillet/shepard.hpp; Masalha et al.
+// 2021 Sec. 7.2). Truths, from the mathematics alone:
 // - the weights: alpha_1 + alpha_2 = 1 (Eq. 9b), alpha_i = 1 where d_i = 0 (Eq. 9a), both in
 //   [0, 1] (Eq. 9c), alpha_1 = d_1^-q / (d_1^-q + d_2^-q);
 // - a planar corner (floor z = 0, x in [2, 3]; wall x = 2, z in [0, 1]; constant colours): the

@@ -1,7 +1,7 @@
-// The volumetric-Boolean-sum fillet (Masalha et al. 2021, Sec. 3.2, Alg. 3, Appendix A / Alg. 7). Expected
-// values from the mathematics: the corner's fillet region has the volume of the ruled fillet
-// (and of the Hermite section by Green's theorem); the chamfer's C_c(1/2) is the incentre of the
-// right isosceles triangle (Eq. A.2); faces are pieces of the inputs; shared faces coincide.
+// The volumetric-Boolean-sum fillet (Masalha et al. 2021, Sec. 3.2, Alg. 3, Appendix A / Alg. 7).
+// Expected values from the mathematics: the corner's fillet region has the volume of the ruled
+// fillet (and of the Hermite section by Green's theorem); the chamfer's C_c(1/2) is the incentre of
+// the right isosceles triangle (Eq. A.2); faces are pieces of the inputs; shared faces coincide.
 // Through fillet_faces, both constructions between two boxes: the volume of the Hermite section
 // by Green's theorem, and the quality report (gaps, G1, glue, det J, property jump).
 #include <catch2/catch.hpp>

@@ -1,6 +1,6 @@
-// The V-rep fillet (Masalha et al. 2021, Sec. 5, Def. 5.1, Lemma 2, Alg. 6): the half volumetric Boolean
-// sum of S^_1 and S^_2 trimmed by S_b (the solid beyond it) and by its own faces S^_1, S^_2 and
-// caps. Expected values from the mathematics: in the right-angled corner T_hbs is the box
+// The V-rep fillet (Masalha et al. 2021, Sec. 5, Def. 5.1, Lemma 2, Alg. 6): the half volumetric
+// Boolean sum of S^_1 and S^_2 trimmed by S_b (the solid beyond it) and by its own faces S^_1, S^_2
+// and caps. Expected values from the mathematics: in the right-angled corner T_hbs is the box
 // spanned by the legs (Def. 5.1 of two perpendicular planar strips), its det J the product of
 // the edge lengths; the trimmed volume is the region between the legs and the Hermite section
 // (Green's theorem), the ruled fillet's; a point is in the trimmed cell exactly when it is in one

@@ -1,7 +1,8 @@
 // Closest points on surfaces (geom/closest_point.hpp). Truths: the distance to a planar patch
 // (perpendicular inside, to the nearest edge or corner outside); to a cylinder of revolution
 // |r - R| within its height (the revolution is within 1e-10 R of the exact circle); the
-// returned point lies on the surface and the residual is normal to it (Eq. 3 of Massarwi & Elber 2016).
+// returned point lies on the surface and the residual is normal to it (Eq. 3
+// of Massarwi & Elber 2016).
 #include <catch2/catch.hpp>
 
 #include <cmath>

@@ -94,8 +94,8 @@ void check_membership(const VModel& m, std::array<double, 3> lo, std::array<doub
 }  // namespace
 
 TEST_CASE("union intersection and subtraction of two boxes: exact membership and cells", "[boolean]") {
-  // Massarwi & Elber 2016, Fig. 3: O1 = [0,2]x[0,1]x[0,1], O2 = [1,2]x[0,1]x[0,2]: A = O1 - O2, B = O1 n O2,
-  // C = O2 - O1.
+  // Massarwi & Elber 2016, Fig. 3: O1 = [0,2]x[0,1]x[0,1], O2 = [1,2]x[0,1]x[0,2]: A = O1 - O2, B =
+  // O1 n O2, C = O2 - O1.
   const std::array<double, 3> a0{0, 0, 0}, a1{2, 1, 1}, b0{1, 0, 0}, b1{2, 1, 2};
   const VModel A = box("A", a0, a1, 0.25), B = box("B", b0, b1, 0.5);
   const auto margin = [&](const slice::Vec3& p) { return std::min(box_margin(p, a0, a1), box_margin(p, b0, b1)); };

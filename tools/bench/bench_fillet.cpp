@@ -1,5 +1,5 @@
-// Fillet construction time and sizes (issue 6; Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8
-// and Table 1): builds the fillet scenes of models/ (default: fillet_spheres, Fig. 13, and
+// Fillet construction time and sizes (issue 6; Masalha, Cirillo & Elber 2021, Masalha et al. 2021,
+// Sec. 8 and Table 1): builds the fillet scenes of models/ (default: fillet_spheres, Fig. 13, and
 // fillet_sphere_cone, Fig. 14) `repeats` times and prints, per fillet, the best time to build it
 // (intersection, rails, sub-regions, blend, ruled fillet and its quality report) beside the
 // paper's "less than a minute each" in IRIT, and the orders and control-point counts of S_1, S_2,

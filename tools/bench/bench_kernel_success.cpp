@@ -1,5 +1,6 @@
 // Success rates of the kernel-based constructors on the random datasets of Fadila, Hong & Elber
-// (Fadila et al. 2023, Sec. 5.1), beside the paper's figures (captions of Figs. 6, 7, 9, 10, 13, 14).
+// (Fadila et al. 2023, Sec. 5.1), beside the paper's figures (captions of
+// Figs. 6, 7, 9, 10, 13, 14).
 //
 // Nine datasets: {Boolean sum, half Boolean sum, ruling} x {cubic Bezier, quartic Bezier,
 // uniform quadratic B-spline with five control points}. Curves run between corners of [-1, 1]^2
@@ -104,9 +105,9 @@ Curve make_curve(Kind kind, const Ctl& c) {
   return Curve({kv}, 2, std::move(p));
 }
 
-/// The control polygons of one random input (Fadila et al. 2023, Sec. 5.1), in the order the regular
-/// constructor takes the curves: Boolean sum [bottom, top, left, right]; half Boolean sum the
-/// top and the left curves, both starting at their shared corner (-1, 1); ruling [bottom, top].
+/// The control polygons of one random input (Fadila et al. 2023, Sec. 5.1), in the order the
+/// regular constructor takes the curves: Boolean sum [bottom, top, left, right]; half Boolean sum
+/// the top and the left curves, both starting at their shared corner (-1, 1); ruling [bottom, top].
 std::vector<Ctl> random_input(Rng& r, KernelOp op, Kind k, bool sorted) {
   auto left = [&] { return random_points(r, k, {-1, -1}, {-1, 1}, {-2, -2}, {0, 2}, sorted); };
   auto right = [&] { return random_points(r, k, {1, -1}, {1, 1}, {0, -2}, {2, 2}, sorted); };
@@ -174,8 +175,8 @@ Curve segment(const std::vector<double>& a, const std::vector<double>& b) {
   return Curve({KnotVector::bezier(2)}, 2, {a[0], a[1], b[0], b[1]});
 }
 
-/// The boundary loop that the regular construction will have (Fadila et al. 2023 Lemmas 1-3), built from
-/// the inputs directly so that screening needs no construction: S(u,0), S(1,v), S(u,1) and
+/// The boundary loop that the regular construction will have (Fadila et al. 2023 Lemmas 1-3), built
+/// from the inputs directly so that screening needs no construction: S(u,0), S(1,v), S(u,1) and
 /// S(0,v), the last two reversed.
 std::vector<Curve> input_loop(KernelOp op, const std::vector<Curve>& c) {
   switch (op) {
@@ -191,10 +192,10 @@ std::vector<Curve> input_loop(KernelOp op, const std::vector<Curve>& c) {
   }
 }
 
-/// Simple boundary and corners turning by less than 180 degrees (Fadila et al. 2023, Sec. 4's assumptions).
-/// Cheapest test first: the corners need only the end tangents, and the sign s for which all
-/// four turn the right way; the orientation (from the signed area) must then be s. The same
-/// verdicts as testing the corners against the orientation directly.
+/// Simple boundary and corners turning by less than 180 degrees (Fadila et al. 2023, Sec. 4's
+/// assumptions). Cheapest test first: the corners need only the end tangents, and the sign s for
+/// which all four turn the right way; the orientation (from the signed area) must then be s. The
+/// same verdicts as testing the corners against the orientation directly.
 const char* screen_boundary(const std::vector<Curve>& loop) {
   // Corners: the incoming tangent of curve c-1 and the outgoing one of curve c.
   int turn = 0;  // +1: every corner turns left, -1: every corner turns right

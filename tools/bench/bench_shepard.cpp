@@ -1,6 +1,6 @@
-// One 1516 x 2524 pixel slice with Shepard-blended fillets (issue 7's benchmark; Masalha et al. 2021
-// Sec. 8: about six minutes for the lamp's Fig. 15 (b) slice in IRIT; target: under a second on
-// 2 cores). The slice is WIDTH x HEIGHT square pixels at height Z, one layer, the model's xy
+// One 1516 x 2524 pixel slice with Shepard-blended fillets (issue 7's benchmark; Masalha et al.
+// 2021 Sec. 8: about six minutes for the lamp's Fig. 15 (b) slice in IRIT; target: under a second
+// on 2 cores). The slice is WIDTH x HEIGHT square pixels at height Z, one layer, the model's xy
 // bounding box centred in it and touching two opposite sides. Timed: sampling the
 // layer (cells and properties of every voxel, LayerSampler, in bands of 64 rows over the
 // threads), with the encoded properties and with the exact Shepard blend (--blend shepard),

@@ -73,11 +73,12 @@ spline::TensorSpline<P> extend_constant(const spline::TensorSpline<P - 1>& s, in
 // ---------------------------------------------------------------------------------------------
 // Extrusion and ruling
 
-/// Ruled surface S(u, v) = (1 - v) bottom(u) + v top(u) (Massarwi & Elber 2016, Sec. 3.2.2 item 2, one
-/// dimension down). `ruling_order` >= 2 raises the ruling direction by degree elevation (the
+/// Ruled surface S(u, v) = (1 - v) bottom(u) + v top(u) (Massarwi & Elber 2016, Sec. 3.2.2 item 2,
+/// one dimension down). `ruling_order` >= 2 raises the ruling direction by degree elevation (the
 /// same surface; Fadila et al. 2023, Sec. 5.1 starts the kernel-based ruling at order 3).
 Surface ruled(const Curve& bottom, const Curve& top, int ruling_order = 2);
-/// Ruled volume T(u, v, w) = (1 - w) s0(u, v) + w s1(u, v) (Massarwi & Elber 2016, Sec. 3.2.2 item 2).
+/// Ruled volume T(u, v, w) = (1 - w) s0(u, v) + w s1(u, v) (Massarwi & Elber
+/// 2016, Sec. 3.2.2 item 2).
 Trivariate ruled(const Surface& s0, const Surface& s1, int ruling_order = 2);
 
 /// Extruded surface S(u, v) = C(u) + V v, v in [0, 1]. `vector` has 1..dim entries; missing
@@ -133,8 +134,8 @@ Surface boolean_sum(const Curve& bottom, const Curve& top, const Curve& left, co
 /// increasing order). The twelve shared edges must coincide.
 Trivariate boolean_sum(std::span<const Surface> faces, const MatchOptions& match = {});
 
-/// Half Boolean sum surface S(u, v) = c1(u) + c2(v) - c1(0), c1(0) = c2(0) (Fadila et al. 2023, Sec. 3.1,
-/// Lemma 1: S(u, 0) = c1(u), S(0, v) = c2(v)).
+/// Half Boolean sum surface S(u, v) = c1(u) + c2(v) - c1(0), c1(0) = c2(0) (Fadila et al. 2023,
+/// Sec. 3.1, Lemma 1: S(u, 0) = c1(u), S(0, v) = c2(v)).
 Surface half_boolean_sum(const Curve& c1, const Curve& c2, const MatchOptions& match = {});
 
 /// Half Boolean sum trivariate of two surfaces sharing C(u) = s1(u, 0) = s2(u, 0):
@@ -144,8 +145,8 @@ Trivariate half_boolean_sum(const Surface& s1, const Surface& s2, const MatchOpt
 
 /// Half Boolean sum trivariate of three surfaces s1(u, v), s2(v, w), s3(u, w) sharing
 /// C1(u) = s1(u, 0) = s3(u, 0), C2(v) = s1(0, v) = s2(v, 0), C3(w) = s2(0, w) = s3(0, w) and the
-/// corner P: T = s1 + s2 + s3 - (C1 + C2 + C3) + P (Fadila et al. 2023, Sec. 3.2, Lemma 3: T(u, v, 0) = s1,
-/// T(0, v, w) = s2, T(u, 0, w) = s3).
+/// corner P: T = s1 + s2 + s3 - (C1 + C2 + C3) + P (Fadila et al. 2023, Sec. 3.2, Lemma 3: T(u, v,
+/// 0) = s1, T(0, v, w) = s2, T(u, 0, w) = s3).
 Trivariate half_boolean_sum(const Surface& s1, const Surface& s2, const Surface& s3,
                             const MatchOptions& match = {});
 
@@ -157,8 +158,8 @@ Trivariate half_boolean_sum(const Surface& s1, const Surface& s2, const Surface&
 /// the sections' control points (NURBS Book eq. 9.5), normalised to [0, 1]; else n strictly
 /// increasing values, mapped onto [0, 1].
 Surface sweep(std::span<const Curve> sections, std::span<const double> params = {}, int order = 4);
-/// The trivariate through surfaces S_i at w_i: T(u, v, w_i) = S_i(u, v) (Massarwi & Elber 2016, Sec. 3.2.2
-/// item 5, volumetric sweep by interpolation).
+/// The trivariate through surfaces S_i at w_i: T(u, v, w_i) = S_i(u, v) (Massarwi & Elber 2016,
+/// Sec. 3.2.2 item 5, volumetric sweep by interpolation).
 Trivariate sweep(std::span<const Surface> sections, std::span<const double> params = {},
                  int order = 4);
 

@@ -50,9 +50,9 @@ enum class AddDof {
 /// What counts as a valid result.
 enum class Acceptance {
   /// det J >= 0 with the boundary's orientation (zero allowed where interior points coincide at
-  /// K: Fadila et al. 2023, Theorem 4 and Sec. 5, the criterion of the paper's success rates). Checked
-  /// like geom::check_validity (Bezier coefficients of det J, subdivision), with coefficients
-  /// within 1e-9 of the largest |coefficient| counted as zero.
+  /// K: Fadila et al. 2023, Theorem 4 and Sec. 5, the criterion of the paper's success rates).
+  /// Checked like geom::check_validity (Bezier coefficients of det J, subdivision), with
+  /// coefficients within 1e-9 of the largest |coefficient| counted as zero.
   nonnegative,
   /// det J > 0 everywhere: geom::check_validity's verdict `valid`.
   positive,
@@ -64,8 +64,8 @@ enum class KernelPoint {
   centroid,
   /// The centroid first; when S_i is not accepted there, the centroid of the part of the kernel
   /// where det J's Bezier coefficients (pieces subdivided up to `fit_subdivisions` times where
-  /// needed) all have the boundary's sign, if that part has positive area (volume). Fadila et al. 2023
-  /// Sec. 7 names "a more careful selection of the interior kernel location" as the degree of
+  /// needed) all have the boundary's sign, if that part has positive area (volume). Fadila et al.
+  /// 2023 Sec. 7 names "a more careful selection of the interior kernel location" as the degree of
   /// freedom the paper did not exercise. With every interior point at K (or at K plus the fixed
   /// Sec. 6 offsets), det J is affine in K: the cross (triple) products of the derivatives lose
   /// every term with K twice, since K x K = 0. So each coefficient is a half-plane (half-space)
@@ -80,8 +80,8 @@ struct KernelConstructOptions {
   /// Largest number of knots per span (refine) or degree raisings (elevate) tried: iterations
   /// i = 0..max_dof. The paper: 20 knots per span; degree up to 17 (40 for quadratic ruling).
   int max_dof = 20;
-  /// Fadila et al. 2023, Sec. 6: 0 moves every interior point to K; s > 0 spreads them on a uniform grid
-  /// centred at K, s times the kernel's size wide (sqrt(area), cbrt(volume)) along axes taken
+  /// Fadila et al. 2023, Sec. 6: 0 moves every interior point to K; s > 0 spreads them on a uniform
+  /// grid centred at K, s times the kernel's size wide (sqrt(area), cbrt(volume)) along axes taken
   /// from the control net (first to last layer per direction).
   double spread = 0.0;
   Acceptance acceptance = Acceptance::nonnegative;
@@ -142,9 +142,10 @@ struct KernelResult {
 template <int P>
 KernelResult<P> kernel_based(const spline::TensorSpline<P>& s0, const KernelConstructOptions& options = {});
 
-/// The regular construction of Fadila et al. 2023 (Alg. 1 line 1) from planar curves (R^k, x y first):
-/// boolean_sum [bottom, top, left, right] (S(u,0), S(u,1), S(0,v), S(1,v)); half_boolean_sum
-/// [c1, c2] with c1(0) = c2(0); ruled [bottom, top] with the ruling at `ruling_order`.
+/// The regular construction of Fadila et al. 2023 (Alg. 1 line 1) from planar curves (R^k, x y
+/// first): boolean_sum [bottom, top, left, right] (S(u,0), S(u,1), S(0,v), S(1,v));
+/// half_boolean_sum [c1, c2] with c1(0) = c2(0); ruled [bottom, top] with the ruling at
+/// `ruling_order`.
 /// @throws trivox::Error (bad_input) for the wrong number of curves or mismatched boundaries
 Surface regular_construct(KernelOp op, std::span<const Curve> curves, const KernelConstructOptions& options = {});
 /// From surfaces: boolean_sum the six faces u0 u1 v0 v1 w0 w1; half_boolean_sum [s1, s2] or

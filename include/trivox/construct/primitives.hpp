@@ -4,8 +4,8 @@
 /// has a vanishing Jacobian; and the property fields that colour them.
 ///
 /// A tensor-product trivariate cylinder or sphere is singular on its axis or at its poles
-/// (Massarwi & Elber 2016, Fig. 8). The primitives avoid that by splitting the solid into cells glued C0 along
-/// shared faces (Sec. 3.2.3):
+/// (Massarwi & Elber 2016, Fig. 8). The primitives avoid that by splitting the solid into cells
+/// glued C0 along shared faces (Sec. 3.2.3):
 ///
 ///  - a *5-cell disk*: a central square of half-width 0.5 r and four cells ruled between the
 ///    square's sides and quarter circles (Fig. 9 (a)-(c)); the cylinder extrudes it along the

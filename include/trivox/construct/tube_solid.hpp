@@ -12,9 +12,9 @@
 ///    t = 1), its w direction the tube's v;
 ///  - `s0` .. `s3`: cell k between the core's side K_k K_{k+1} (w = 0) and the quarter of the tube
 ///    S(u, v), u in [k/4, (k+1)/4] (w = 1); (s, v, w): s around, v along, w outward.
-/// Each cell is construct::boolean_sum (Massarwi & Elber 2016, Sec. 3.2.2 item 4) of its six faces, all ruled
-/// surfaces or quarters of S, so the cells are exactly the ruled constructions and glue along
-/// shared faces (the core's t = 1 and s = 0 sides run backwards against s2's and s3's w = 0).
+/// Each cell is construct::boolean_sum (Massarwi & Elber 2016, Sec. 3.2.2 item 4) of its six faces,
+/// all ruled surfaces or quarters of S, so the cells are exactly the ruled constructions and glue
+/// along shared faces (the core's t = 1 and s = 0 sides run backwards against s2's and s3's w = 0).
 /// Where S's cross-sections are convex and advance along v (each cross-section planar or nearly,
 /// the tube's axis transverse to them), det J keeps one sign; the cells are oriented positively
 /// (u of S is reversed when the core's det J at its centre is negative).

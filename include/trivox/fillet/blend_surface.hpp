@@ -1,7 +1,7 @@
 /// @file trivox/fillet/blend_surface.hpp
 /// @brief The blending surface S_b between two rails: the cubic Hermite surface of Masalha,
-/// Cirillo & Elber 2021 (Masalha et al. 2021, Sec. 1.1-1.4, Eq. 1, Alg. 1), or the flend cross-section of
-/// Eager & Dannenhoffer (Sec. II.A) with its `dip`.
+/// Cirillo & Elber 2021 (Masalha et al. 2021, Sec. 1.1-1.4, Eq. 1, Alg. 1), or the flend
+/// cross-section of Eager & Dannenhoffer (Sec. II.A) with its `dip`.
 ///
 /// Both interpolate the rail curves C_1^r(t), C_2^r(t) exactly (they are taken as given, in the
 /// caller's function space) and leave them in the primary surfaces' tangent planes (G1), which

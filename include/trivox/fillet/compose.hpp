@@ -64,8 +64,8 @@ struct SubregionReport {
   double fit_error = 0.0;  ///< fit: largest xyz distance found at the check points
 };
 
-/// S^(u, v) = s((1 - v) from(u) + v to(u)) (Masalha et al. 2021 Eqs. 2-3), u along the curves, v from
-/// `from` (v = 0) to `to` (v = 1). The curves are in s's parameter space and in one function
+/// S^(u, v) = s((1 - v) from(u) + v to(u)) (Masalha et al. 2021 Eqs. 2-3), u along the curves, v
+/// from `from` (v = 0) to `to` (v = 1). The curves are in s's parameter space and in one function
 /// space (same order and knots). A fit keeps its two boundaries exactly on s(from) and s(to) as
 /// fitted curves: S^(u, 0) and S^(u, 1) are themselves least-squares curves of those images.
 /// @throws Error (bad_input) for curves outside s's domain or in different spaces, or for

@@ -107,7 +107,8 @@ struct Fillet {
   FilletQuality quality;
   /// The rails of the intersection component this fillet belongs to (over the whole component,
   /// also for a matched piece of it), and the component's index in intersect_surfaces' order:
-  /// what the multi-face fillet of fillet/corners.hpp (Masalha et al. 2021, Sec. 6) joins at the corners.
+  /// what the multi-face fillet of fillet/corners.hpp (Masalha et al. 2021,
+  /// Sec. 6) joins at the corners.
   RailPair rails;
   std::size_t component = 0;
 
@@ -121,7 +122,8 @@ double outward_sign(const spline::Trivariate& cell, spline::Face face);
 
 /// The fillets between face f1 of cell1 and face f2 of cell2, one per intersection component, or
 /// with matched Bezier pairs (SubregionMethod::matched, or automatic on B-spline faces where
-/// Lemma 1 holds; fillet/matched.hpp, Masalha et al. 2021, Alg. 4-5) one per piece, in order along C.
+/// Lemma 1 holds; fillet/matched.hpp, Masalha et al. 2021, Alg. 4-5) one
+/// per piece, in order along C.
 /// @throws Error (bad_input) for cells of different dimensions, faces that do not intersect
 ///         ("... do not intersect"), an intersection that is only a point, distances or
 ///         parameters out of range or rails leaving their face (the message names the face);

@@ -22,7 +22,8 @@
 ///   the fillet runs along C from t_p to t_{p+1} and along rail i from r_{i,p} to r_{i,p+1};
 ///   its boundary between pieces is, on each face, a segment of the iso-line from C to the rail,
 ///   so the sub-region pieces (ruled surfaces in the face's parameters between the reparametrised
-///   pieces of c^{S_i} and c_i^r, Masalha et al. 2021 Eqs. 2-3) stay inside one Bezier patch and compose
+///   pieces of c^{S_i} and c_i^r, Masalha et al. 2021 Eqs. 2-3) stay inside
+/// one Bezier patch and compose
 ///   exactly (compose.hpp). Neighbouring pieces share that boundary, the blending surfaces
 ///   interpolate the same end points with the same tangent fields, so the fillets of Alg. 5's
 ///   line 20 (BzrFillet, Alg. 2) join continuously.

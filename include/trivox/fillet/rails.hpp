@@ -58,8 +58,8 @@ struct RailOptions {
 struct Rail {
   spline::Curve base;  ///< c_I^{S_i}(t): C in the face's parameters (R^2)
   spline::Curve rail;  ///< c_i^r(t): the rail in the face's parameters (R^2)
-  /// Parameter intervals [t0, t1] where a self-crossing was trimmed (the rail is constant there),
-  /// sorted.
+  /// Parameter intervals [t0, t1] where a self-crossing was trimmed (the rail
+  /// is constant there), sorted.
   std::vector<std::array<double, 2>> trimmed;
   /// Largest deviation found when checking between samples: | |S(rail(t)) - C(t)| - d |,
   /// |(S(rail(t)) - C(t)) . T(t)| (C(t) the mean of S_1(base_1(t)) and S_2(base_2(t)), T the unit
@@ -72,8 +72,8 @@ struct Rail {
 /// rails[1].base, rails[1].rail) share one parameter t in [0, 1] and one function space (order
 /// 4, the same clamped knots; interior knots of multiplicity 3 at the trimmed ends of either
 /// rail), so that the ruled surfaces (1 - s) base(t) + s rail(t) are tensor-product splines
-/// (Masalha et al. 2021, Eq. 3) and S_1(rails[0].base(t)) = S_2(rails[1].base(t)) = C(t) at the same t (to
-/// the tolerance).
+/// (Masalha et al. 2021, Eq. 3) and S_1(rails[0].base(t)) = S_2(rails[1].base(t)) = C(t) at the
+/// same t (to the tolerance).
 struct RailPair {
   std::array<Rail, 2> rails;
   bool closed = false;  ///< C, and so all four curves, are closed loops (value at t = 0 equals t = 1)

@@ -45,8 +45,8 @@
 ///
 /// Jacobians: T_1 has no degenerate edge (the angle at C is the faces' dihedral angle). T_2 and
 /// T_3 each have one zero-angle edge, the rail, where S_b is tangent to S^_i (G1): det J vanishes
-/// along it (Masalha et al. 2021, Sec. 9, "at the rail curves, the Jacobian of all presented approaches
-/// vanish"), positive elsewhere when the division does not fold.
+/// along it (Masalha et al. 2021, Sec. 9, "at the rail curves, the Jacobian of all presented
+/// approaches vanish"), positive elsewhere when the division does not fold.
 ///
 /// Knots across that come from different pieces (restrictions, normalisations, reversal) and
 /// agree to 1e-11 are merged, and a projection parameter within 1e-11 of a knot is moved onto it,

@@ -18,7 +18,8 @@
 ///   (vmodel::VCell::without: point membership exact by inversion, as the Booleans use it, and
 ///   what slice::apply_trimming and Locator::admits honour), so S_b is given as the face of the
 ///   solid W beyond it: W_1 = Rld(S_b[0, v_b], T_hbs v1) and W_2 = Rld(S_b[v_b, 1], T_hbs w1
-///   reversed), the ruled volumes (Massarwi & Elber 2016, Sec. 3.2.2) between S_b and the far faces of T_hbs,
+///   reversed), the ruled volumes (Massarwi & Elber 2016, Sec. 3.2.2) between S_b
+/// and the far faces of T_hbs,
 ///   glued along Rld(C_b, K). The fillet is the cell {T_hbs without {W_1, W_2}}: its boundary is
 ///   S^_1, S^_2 (T_hbs), S_b (W's face w0) and, for an open C, the caps: T_hbs's end faces
 ///   trimmed by the loop of Alg. 6 line 11: C_u, C_v (the cap's edges v = 0, w = 0) and C_Sb, where
@@ -44,8 +45,8 @@
 /// the trimmed cell's volume is |T_hbs| - |W_1| - |W_2|, each integral exact to rounding.
 ///
 /// Cost: one half Boolean sum (the control nets of S^_1 and S^_2 added: n_u x n_v x n_w points),
-/// two ruled volumes, a few hundred point inversions for the report and the caps' trimming
-/// curves.
+/// two ruled volumes, a few hundred point inversions for the report and
+/// the caps' trimming curves.
 #pragma once
 #include <array>
 #include <string>

@@ -2,14 +2,14 @@
 /// @brief Conservative kernels of closed loops of planar curves and of closed sets of surfaces:
 /// a convex polygon (polyhedron) of points that see the whole boundary.
 ///
-/// Hong & Elber 2022 (cited in Fadila et al. 2023, Secs. 2 and 5.1): a point K is in the kernel of a closed
-/// boundary iff it lies on the inner side of every tangent line (plane). For a counter-clockwise
-/// loop of curves C that is f_K(t) = C'(t) x (K - C(t)) >= 0 for all t; for surfaces with outward
-/// normals n = S_u x S_v it is g_K(u,v) = n(u,v) . (K - S(u,v)) <= 0. Both f_K and g_K are
-/// splines (derivative and product splines, spline/calculus.hpp) whose coefficients are affine in
-/// K, so requiring every coefficient to have the right sign is a sufficient condition (convex
-/// hull property): a finite set of half-planes (half-spaces) whose intersection lies inside the
-/// true kernel. Refining f_K (g_K) replaces each coefficient by convex combinations of its
+/// Hong & Elber 2022 (cited in Fadila et al. 2023, Secs. 2 and 5.1): a point K is in the kernel of
+/// a closed boundary iff it lies on the inner side of every tangent line (plane). For a
+/// counter-clockwise loop of curves C that is f_K(t) = C'(t) x (K - C(t)) >= 0 for all t; for
+/// surfaces with outward normals n = S_u x S_v it is g_K(u,v) = n(u,v) . (K - S(u,v)) <= 0. Both
+/// f_K and g_K are splines (derivative and product splines, spline/calculus.hpp) whose coefficients
+/// are affine in K, so requiring every coefficient to have the right sign is a sufficient condition
+/// (convex hull property): a finite set of half-planes (half-spaces) whose intersection lies inside
+/// the true kernel. Refining f_K (g_K) replaces each coefficient by convex combinations of its
 /// neighbours, so the conservative kernel only grows with `KernelOptions::refinements` and tends
 /// to the true kernel. The half-planes (half-spaces) are intersected by clipping a box around the
 /// input (its control points), one constraint after the other.
@@ -79,8 +79,8 @@ PlanarKernel planar_kernel(std::span<const spline::Curve> loop, const KernelOpti
 /// reversed, S(u0, v) reversed (counter-clockwise when det J > 0).
 std::vector<spline::Curve> boundary_loop(const spline::Surface& s);
 
-/// planar_kernel(boundary_loop(s)): the kernel of a planar surface's boundary (Fadila et al. 2023, Sec. 5.1
-/// uses the boundary of the regular construction S_0 as the kernel's input).
+/// planar_kernel(boundary_loop(s)): the kernel of a planar surface's boundary (Fadila et al. 2023,
+/// Sec. 5.1 uses the boundary of the regular construction S_0 as the kernel's input).
 PlanarKernel planar_kernel(const spline::Surface& s, const KernelOptions& options = {});
 
 /// The conservative kernel of a closed set of polynomial surfaces (coordinates 0..2 are xyz)
@@ -101,8 +101,9 @@ SpatialKernel spatial_kernel(const spline::Trivariate& t, const KernelOptions& o
 /// The part of a kernel polygon where further affine constraints hold: {a, b, c} keeps the
 /// points with a x + b y + c >= 0. Constraints with (a, b) = 0 keep everything when c >= 0 and
 /// nothing otherwise. The result's `constraints` counts k's and the ones given; `orientation` is
-/// k's. Used to pick the kernel point of Fadila et al. 2023, Alg. 1 more carefully (Sec. 7), where det J's
-/// coefficients, affine in that point, give the constraints (construct/kernel_construct.hpp).
+/// k's. Used to pick the kernel point of Fadila et al. 2023, Alg. 1 more carefully (Sec. 7), where
+/// det J's coefficients, affine in that point, give the constraints
+/// (construct/kernel_construct.hpp).
 PlanarKernel restrict_kernel(const PlanarKernel& k, std::span<const std::array<double, 3>> constraints);
 
 /// The same for a kernel polyhedron: {a, b, c, d} keeps a x + b y + c z + d >= 0.

@@ -8,7 +8,8 @@
 /// construction, 3 for spatial, more for properties), plus the operation's own fields:
 ///   - "boolean_sum": 4 curves [bottom, top, left, right] or 6 surfaces [u0, u1, v0, v1, w0, w1];
 ///   - "half_boolean_sum": 2 curves, or 2 or 3 surfaces;
-///   - "ruled": 2 curves or surfaces [bottom, top]; "ruling_order" (default 3, Fadila et al. 2023, Sec. 5.1);
+///   - "ruled": 2 curves or surfaces [bottom, top]; "ruling_order" (default 3,
+/// Fadila et al. 2023, Sec. 5.1);
 ///   - "extrude": 1 curve or surface and "vector" [x, y, (z, ...)];
 ///   - "revolve": 1 curve or surface, "axis" [x, y, z], optional "origin", "angle" (degrees,
 ///     default 360), "tolerance" (relative, default 1e-6);

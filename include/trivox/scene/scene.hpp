@@ -5,44 +5,44 @@
 ///
 /// A scene has the model file's header (`trivox`, `units`, `properties`) and `cells`, each
 /// either `{"name", "trivariate": SPLINE}` as in a model or `{"name", "primitive": {...},
-/// "field": {...}}` (construct/primitives.hpp: Massarwi & Elber 2016, Sec. 3.2.3), optional free `surfaces`,
-/// and `operations`, a list of `{"op": NAME, ...}`. Reading checks every value before use and
-/// reports the first problem as trivox::Error (bad_input) "<file>: <JSON pointer>: <found>;
+/// "field": {...}}` (construct/primitives.hpp: Massarwi & Elber 2016, Sec. 3.2.3), optional free
+/// `surfaces`, and `operations`, a list of `{"op": NAME, ...}`. Reading checks every value before
+/// use and reports the first problem as trivox::Error (bad_input) "<file>: <JSON pointer>: <found>;
 /// expected <what>", reusing the model reader's checked access (src/io/json_io.hpp).
 ///
 /// Operations: the names of docs/model-format.md (`union`, `intersection`, `subtraction`, `fillet` and the
 /// constructors `ruled`, `extrude`, `revolve`, `boolean_sum`, `half_boolean_sum`, `sweep`) are
-/// recognised. The Booleans are built (vmodel/boolean.hpp: Massarwi & Elber 2016, Alg. 1-3): {"op": "union",
-/// "a": NAME, "b": NAME, "name": RESULT (default: a), "blend": "sum_clip" | "mean" | "first" |
-/// "distance", "power": k}, where a and b name scene cells (a primitive's cells all together) or
-/// earlier results; the operation consumes a and b and puts its result, untrimmed
-/// (slice::untrim), where a was. Fillets (fillet/fillet.hpp: Masalha et al. 2021, Alg. 2 with Sec. 7.1):
-/// {"op": "fillet", "between": [A, B], "distance": d | [d1, d2], "tau", "section": "hermite" |
-/// "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric" | "shepard",
-/// "power": q (Shepard only, 1..16, default 2; fillet/shepard.hpp, Masalha et al. 2021, Sec. 7.2), "flip": bool |
-/// [bool, bool], "construction": "ruled" | "vbs" | "vrep", "name"}, A and B cell names or {"cell": NAME,
-/// "face": "u0".."w1"}; without faces, the one pair of faces that intersects is used. With
-/// "bridge": true (and both faces named) the fillet is a flend between disjoint faces instead
-/// (fillet/bridge.hpp, Eager & Dannenhoffer 2019, Sec. III): one cell `<name>.1` from face to face, with "dip".
-/// With a list [{"cell", "face"}, ...] on either side of "between", the fillet runs over several
-/// faces (fillet/corners.hpp, Masalha et al. 2021, Sec. 6): one fillet per pair of listed faces that crosses
-/// along a curve, chained along C, cells `<name>.<k>a`, `<name>.<k>b` in chain order; with
-/// "corners": "bridge" (the default; "open" leaves the gaps, Fig. 12 (c)) each convex C1 corner
-/// gets the singular bridging fillet of Sec. 6.1, cells `<name>.c<j>a`, `<name>.c<j>b`. Ruled
-/// construction, Hermite section and the parametric blend only.
-/// The fillet's cells, two per intersection component (`<name>.<k>a`, `<name>.<k>b`; with
-/// "construction": "vbs", Masalha et al. 2021, Sec. 3.2 / Alg. 3, three: `<name>.<k>.1` at C, `.2` at
-/// rail 1, `.3` at rail 2; with "vrep", Sec. 5 / Alg. 6, one trimmed cell `<name>.<k>`, the
-/// half volumetric Boolean sum without the solid beyond S_b (fillet/vrep_fillet.hpp); vbs and
-/// vrep are refused with the Shepard blend), are appended to the model; the
-/// filleted cells stay as they are. Constructors (Massarwi & Elber 2016, Sec. 3.2.2, construct/constructors.hpp)
-/// build cells from scene surfaces: {"op": "ruled" | "boolean_sum" | "half_boolean_sum" |
-/// "extrude" | "revolve" | "sweep", "surfaces": [NAME, ...], "name", "field", ...} (revolve: "axis",
-/// "origin", "angle" in degrees, "tolerance" as `trivox construct`), or {"op": "boolean_sum",
-/// "tube": NAME, "core"} for the five cells inside a tube (construct/tube_solid.hpp); scene
-/// surfaces may be G+Smo patches merged ({"name", "gismo": FILE, "patches", "scale", "u", "v"})
-/// or offsets ({"name", "offset": {"surface", "distance", "tolerance"}}). An unknown name is
-/// refused by the reader, which lists the known ones.
+/// recognised. The Booleans are built (vmodel/boolean.hpp: Massarwi & Elber 2016, Alg. 1-3): {"op":
+/// "union", "a": NAME, "b": NAME, "name": RESULT (default: a), "blend": "sum_clip" | "mean" |
+/// "first" | "distance", "power": k}, where a and b name scene cells (a primitive's cells all
+/// together) or earlier results; the operation consumes a and b and puts its result, untrimmed
+/// (slice::untrim), where a was. Fillets (fillet/fillet.hpp: Masalha et al. 2021, Alg. 2 with Sec.
+/// 7.1): {"op": "fillet", "between": [A, B], "distance": d | [d1, d2], "tau", "section": "hermite"
+/// | "flend", "dip", "method": "auto" | "compose" | "fit", "blend": "parametric" | "shepard",
+/// "power": q (Shepard only, 1..16, default 2; fillet/shepard.hpp, Masalha et al. 2021, Sec. 7.2),
+/// "flip": bool | [bool, bool], "construction": "ruled" | "vbs" | "vrep", "name"}, A and B cell
+/// names or {"cell": NAME, "face": "u0".."w1"}; without faces, the one pair of faces that
+/// intersects is used. With "bridge": true (and both faces named) the fillet is a flend between
+/// disjoint faces instead (fillet/bridge.hpp, Eager & Dannenhoffer 2019, Sec. III): one cell
+/// `<name>.1` from face to face, with "dip". With a list [{"cell", "face"}, ...] on either side of
+/// "between", the fillet runs over several faces (fillet/corners.hpp, Masalha et al. 2021, Sec. 6):
+/// one fillet per pair of listed faces that crosses along a curve, chained along C, cells
+/// `<name>.<k>a`, `<name>.<k>b` in chain order; with "corners": "bridge" (the default; "open"
+/// leaves the gaps, Fig. 12 (c)) each convex C1 corner gets the singular bridging fillet of Sec.
+/// 6.1, cells `<name>.c<j>a`, `<name>.c<j>b`. Ruled construction, Hermite section and the
+/// parametric blend only. The fillet's cells, two per intersection component (`<name>.<k>a`,
+/// `<name>.<k>b`; with "construction": "vbs", Masalha et al. 2021, Sec. 3.2 / Alg. 3, three:
+/// `<name>.<k>.1` at C, `.2` at rail 1, `.3` at rail 2; with "vrep", Sec. 5 / Alg. 6, one trimmed
+/// cell `<name>.<k>`, the half volumetric Boolean sum without the solid beyond S_b
+/// (fillet/vrep_fillet.hpp); vbs and vrep are refused with the Shepard blend), are appended to the
+/// model; the filleted cells stay as they are. Constructors (Massarwi & Elber 2016, Sec. 3.2.2,
+/// construct/constructors.hpp) build cells from scene surfaces: {"op": "ruled" | "boolean_sum" |
+/// "half_boolean_sum" | "extrude" | "revolve" | "sweep", "surfaces": [NAME, ...], "name", "field",
+/// ...} (revolve: "axis", "origin", "angle" in degrees, "tolerance" as `trivox construct`), or
+/// {"op": "boolean_sum", "tube": NAME, "core"} for the five cells inside a tube
+/// (construct/tube_solid.hpp); scene surfaces may be G+Smo patches merged ({"name", "gismo": FILE,
+/// "patches", "scale", "u", "v"}) or offsets ({"name", "offset": {"surface", "distance",
+/// "tolerance"}}). An unknown name is refused by the reader, which lists the known ones.
 ///
 /// Cost: linear in the file size to read; building is the primitives' cost (milliseconds each)
 /// plus any field refinement.
@@ -100,8 +100,8 @@ struct SceneSurfaceRecipe {
   construct::OffsetOptions offset;        ///< "offset": tolerance
 };
 
-/// The fields of a constructor operation (ruled, boolean_sum, half_boolean_sum, extrude, revolve,
-/// sweep).
+/// The fields of a constructor operation (ruled, boolean_sum, half_boolean_sum,
+/// extrude, revolve, sweep).
 struct SceneConstructor {
   std::vector<std::string> surfaces;      ///< the input surfaces' names, in the op's order
   std::string tube;                       ///< boolean_sum: the tube whose solid is built (5 cells)
@@ -205,7 +205,8 @@ struct BridgeBuild {
   double seconds = 0.0;
 };
 
-/// What one bridging fillet of a fillet over several faces gave (Masalha et al. 2021, Sec. 6.1): two cells.
+/// What one bridging fillet of a fillet over several faces gave (Masalha et al.
+/// 2021, Sec. 6.1): two cells.
 struct CornerBuild {
   std::string name;                       ///< the operation's result name
   std::string pointer;                    ///< "/operations/<i>"
@@ -219,8 +220,8 @@ struct CornerBuild {
   fillet::CornerQuality quality;
 };
 
-/// A concave corner of a fillet over several faces (Masalha et al. 2021, Sec. 6): the two pieces clipped at
-/// the rails' crossing and stitched.
+/// A concave corner of a fillet over several faces (Masalha et al. 2021, Sec. 6): the two pieces
+/// clipped at the rails' crossing and stitched.
 struct StitchBuild {
   std::string name;                   ///< the operation's result name
   std::string pointer;                ///< "/operations/<i>"

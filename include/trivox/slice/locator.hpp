@@ -2,8 +2,9 @@
 /// @brief Point location in a V-model: which cell contains a point xyz, and at which (u,v,w).
 ///
 /// The inverse of the cells' maps X_c(u,v,w) -> xyz, the question every voxel of a print job asks
-/// (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8: a V-model is "sliced" by sampling geometry and
-/// materials together at every voxel of every layer; their research code took minutes per slice).
+/// (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8: a V-model is "sliced" by sampling
+/// geometry and materials together at every voxel of every layer; their research
+/// code took minutes per slice).
 ///
 /// How: every cell is cut into its Bezier pieces (polynomial or rational, kept in Bernstein form
 /// for fast evaluation) and each piece is subdivided in parameter space into *leaves* until its
@@ -222,9 +223,9 @@ public:
   /// the tolerance). Always true for plain cells. When `props` is not null it holds the
   /// trivariate's own m values on entry and, if p is admitted, leaves with c's blended
   /// properties: combined with the within cells' values at p (their own blends applied) by the
-  /// cell's rule (sum clipped to [0, 1], the mean, or Massarwi & Elber 2016, Eq. 2's distance weights: one
-  /// closest-point query per boundary surface of each input). Unchanged for plain cells and
-  /// BlendRule::first. One point location per condition, whether or not props are wanted.
+  /// cell's rule (sum clipped to [0, 1], the mean, or Massarwi & Elber 2016, Eq. 2's distance
+  /// weights: one closest-point query per boundary surface of each input). Unchanged for plain
+  /// cells and BlendRule::first. One point location per condition, whether or not props are wanted.
   bool admits(int cell, const Vec3& p, double* props = nullptr) const;
   const LocatorOptions& options() const noexcept;
 

@@ -2,10 +2,10 @@
 /// @brief Sampling a V-model on a printer's voxel grid, a band of image rows at a time: per voxel
 /// the cell that contains its centre (or void) and the model's properties there.
 ///
-/// The print job's hot path (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8: V-models sliced
-/// into Voxel Print images, geometry and materials together; their research code took about six
-/// minutes for a 1516 x 2524 slice). A layer is processed in blocks of 4 image rows, cell by cell
-/// in file order (a voxel taken by a cell is skipped by later ones: the first cell wins on
+/// The print job's hot path (Masalha, Cirillo & Elber 2021, Masalha et al. 2021, Sec. 8: V-models
+/// sliced into Voxel Print images, geometry and materials together; their research code took about
+/// six minutes for a 1516 x 2524 slice). A layer is processed in blocks of 4 image rows, cell by
+/// cell in file order (a voxel taken by a cell is skipped by later ones: the first cell wins on
 /// overlap), each row from left to right:
 /// - Empty space is skipped: a row line meets only some leaves' regions (locator.hpp; the
 ///   sampler asks for leaves within about one voxel of affine), each gives an x-interval, and
@@ -60,8 +60,8 @@
 /// voxel's centre (certified voxels: by the bounds above; evaluated voxels: exact at a (u,v,w)
 /// whose image lies within the tolerance of the centre). The (u,v,w) kept with
 /// SamplerOptions::keep_uvw map within the tolerance of the centre for evaluated voxels and within
-/// half the smallest pitch for certified ones (their exact preimage being within the certified
-/// radius).
+/// half the smallest pitch for certified ones (their exact preimage being
+/// within the certified radius).
 ///
 /// Booleans: for a model with trimmed cells (vmodel/boolean.hpp), each sampled band then goes
 /// through slice/trim.hpp's apply_trimming, so occupancy and properties follow the trimming
@@ -126,9 +126,9 @@ struct RowBand {
 /// Which properties the fillet cells that carry Shepard data (vmodel::ShepardData) get.
 enum class PropertyBlend : std::uint8_t {
   encoded,  ///< their control points' (the least-squares encoding of f): the default
-  /// f itself, exactly per voxel (Masalha et al. 2021, Sec. 7.2; vmodel/shepard_field.hpp): two closest-point
-  /// queries per voxel of those cells, warm-started along each image row of a block (cold at
-  /// every row's first such voxel), so a voxel's value depends only on its block.
+  /// f itself, exactly per voxel (Masalha et al. 2021, Sec. 7.2; vmodel/shepard_field.hpp): two
+  /// closest-point queries per voxel of those cells, warm-started along each image row of a block
+  /// (cold at every row's first such voxel), so a voxel's value depends only on its block.
   shepard,
 };
 

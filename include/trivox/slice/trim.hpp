@@ -1,6 +1,6 @@
 /// @file trivox/slice/trim.hpp
-/// @brief The Booleans' trimming applied to a sampled band of voxels (Massarwi & Elber 2016, Sec. 4: the
-/// result's cells are mutually exclusive pieces of the inputs' cells; vmodel/boolean.hpp).
+/// @brief The Booleans' trimming applied to a sampled band of voxels (Massarwi & Elber 2016, Sec.
+/// 4: the result's cells are mutually exclusive pieces of the inputs' cells; vmodel/boolean.hpp).
 ///
 /// The layer sampler assigns each voxel to the first cell whose trivariate holds its centre.
 /// For a model with trimmed cells this pass then corrects every voxel owned by a trimmed cell:
@@ -33,10 +33,10 @@ double trimmed_volume(const Locator& loc, int cell, int divisions = 16);
 
 /// The model with every trimmed cell whose admitted part is the image of a parameter box
 /// restricted to that box (spline::restrict_to), so that its trivariate's faces are the piece's
-/// faces: two boxes united give three box cells glued face to face (Massarwi & Elber 2016, Fig. 3), a cylinder
-/// cut across its axis keeps a shorter cylinder. The box is found on a 17^3 grid of parameters
-/// (the admitted ones must fill an index box exactly), its faces by bisection along lines
-/// through its centre to 1e-13 of the domain, then checked at 9^3 points inside and at points
+/// faces: two boxes united give three box cells glued face to face (Massarwi & Elber 2016, Fig. 3),
+/// a cylinder cut across its axis keeps a shorter cylinder. The box is found on a 17^3 grid of
+/// parameters (the admitted ones must fill an index box exactly), its faces by bisection along
+/// lines through its centre to 1e-13 of the domain, then checked at 9^3 points inside and at points
 /// just outside every cut face. The trimming conditions are kept, so membership stays exact
 /// even where this reading of the region were wrong; cells whose region is not such a box are
 /// returned unchanged. Cost per trimmed cell: about 6,000 membership tests.

@@ -14,9 +14,9 @@
 /// zero on S^_i, where
 /// alpha_i = 1 exactly (Eq. 9a, feature preservation), alpha_1 + alpha_2 = 1 (Eq. 9b) and both in
 /// [0, 1] (Eq. 9c). On the intersection curve C both distances vanish and f is not continuous
-/// there when g_1 != g_2 on C (Masalha et al. 2021, Sec. 7.1 notes the same of the parametric blend); there
-/// trivox takes alpha_1 = alpha_2 = 1/2. Elsewhere f is continuous (C^q away from the points where
-/// a closest point jumps).
+/// there when g_1 != g_2 on C (Masalha et al. 2021, Sec. 7.1 notes the same of the parametric
+/// blend); there trivox takes alpha_1 = alpha_2 = 1/2. Elsewhere f is continuous (C^q away from the
+/// points where a closest point jumps).
 ///
 /// Closest points: geom::SurfaceDistance on S^_1 and S^_2, warm-started along a walk of nearby
 /// points (ShepardWalk): Newton from the previous point's (u, v), accepted when it settles and

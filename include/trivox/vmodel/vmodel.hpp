@@ -18,17 +18,18 @@
 namespace trivox::vmodel {
 
 /// How the properties of a cell that lies in several inputs' cells combine (Booleans,
-/// Massarwi & Elber 2016, Sec. 3.1.2): the cell's own trivariate and each `within` cell give values at a point.
+/// Massarwi & Elber 2016, Sec. 3.1.2): the cell's own trivariate and each `within`
+/// cell give values at a point.
 enum class BlendRule {
   first,    ///< the cell's own trivariate alone
   sum_clip, ///< the sum of all values, clipped to [0, 1] (Massarwi & Elber 2016, Fig. 5: colours summed)
   mean,     ///< their average
-  /// Massarwi & Elber 2016, Eq. 2: the average weighted by d_i^k, d_i the distance from the point to the
-  /// boundary of the input model that value i comes from (VCell::boundaries), k = blend_power.
-  /// On the boundary of one input, the other inputs' values alone remain, so the attribute is C0
-  /// across the intersection cell's boundary. (Eq. 2 measures the distance to the part of that
-  /// boundary inside the other input; the whole boundary vanishes on the same parts of the
-  /// cell's boundary, so continuity is the same, only the interior weights differ.)
+  /// Massarwi & Elber 2016, Eq. 2: the average weighted by d_i^k, d_i the distance from the point
+  /// to the boundary of the input model that value i comes from (VCell::boundaries), k =
+  /// blend_power. On the boundary of one input, the other inputs' values alone remain, so the
+  /// attribute is C0 across the intersection cell's boundary. (Eq. 2 measures the distance to the
+  /// part of that boundary inside the other input; the whole boundary vanishes on the same parts of
+  /// the cell's boundary, so continuity is the same, only the interior weights differ.)
   distance,
 };
 
@@ -38,8 +39,9 @@ const char* blend_rule_name(BlendRule r) noexcept;
 bool blend_rule_from_name(std::string_view name, BlendRule& out) noexcept;
 
 /// Trimming curves on one boundary face of a cell's trivariate: where the other input of a
-/// Boolean cuts that face (surface-surface intersection, Massarwi & Elber 2016, Sec. 4), as curves in the
-/// face's parameter space (R^2; the face's parameters are the two other directions in order).
+/// Boolean cuts that face (surface-surface intersection, Massarwi & Elber 2016, Sec. 4), as curves
+/// in the face's parameter space (R^2; the face's parameters are the two
+/// other directions in order).
 struct FaceTrim {
   spline::Face face = spline::Face::u0;
   std::vector<spline::Curve> curves;
@@ -64,12 +66,12 @@ struct ShepardData {
 
 /// One volumetric cell: a trivariate in R^(3+m), coordinates 0..2 xyz and 3.. the properties.
 ///
-/// A plain cell is the image of its trivariate. A cell made by a Boolean operation (Massarwi & Elber 2016
-/// Sec. 4, Alg. 1-3) is *trimmed*: it is the part of that image that lies in every `within` cell
-/// and in none of the cells of any `without` list (Def. 3.2: a V-cell is in the intersection of
-/// one or more trivariates; here the trimming is given by the other inputs' cells themselves, so
-/// membership is exact at every point, decided by point inversion). Intersection cells keep the
-/// other input's cell in `within`, with its trivariate and attributes, and blend the
+/// A plain cell is the image of its trivariate. A cell made by a Boolean operation (Massarwi &
+/// Elber 2016 Sec. 4, Alg. 1-3) is *trimmed*: it is the part of that image that lies in every
+/// `within` cell and in none of the cells of any `without` list (Def. 3.2: a V-cell is in the
+/// intersection of one or more trivariates; here the trimming is given by the other inputs' cells
+/// themselves, so membership is exact at every point, decided by point inversion). Intersection
+/// cells keep the other input's cell in `within`, with its trivariate and attributes, and blend the
 /// properties by `blend`. The nesting follows the Boolean expression: a `within` cell or a
 /// `without` cell may itself be trimmed.
 struct VCell {
