@@ -41,14 +41,12 @@ std::string num(double v) {
   return std::string(buf, std::to_chars(buf, buf + sizeof buf, v).ptr);
 }
 
-/// A checked value (check_config) in plain decimal notation, never with an exponent: readers
-/// of ConfigFile.xml parse 100000 as an integer but not 1e+05 (a 0.1 mm layer's thickness).
-std::string decimal(double v) {
-  char buf[400];  // check_config bounds v to (0, 1e9]: 10 digits before the point, 340 at most after
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed);
-  if (r.ec != std::errc{}) throw Error("ConfigFile.xml: cannot write the number " + num(v) + " in decimal notation");
-  return std::string(buf, r.ptr);
-}
+/// A checked whole number (check_config: at most 1e9) as an integer: every reader of
+/// ConfigFile.xml parses these elements as integers (voxelprint-preview: parseInt), so
+/// `1000.9999999999999` would read as 1000 and `1e+05` as 1.
+std::string integer(double v) { return std::to_string(std::llround(v)); }
+
+bool whole(double v) { return std::isfinite(v) && v == std::floor(v); }
 
 std::string in_quotes(std::string_view s) {
   std::string out;
@@ -195,6 +193,17 @@ void check_config(const StackConfig& c) {
   if (!(c.dpi_y > 0 && c.dpi_y <= max_dpi)) bad("YDpi " + num(c.dpi_y) + "; expected " + dpi_expected);
   if (!(c.slice_thickness_nm > 0 && c.slice_thickness_nm <= max_thickness_nm))
     bad("SliceThicknessNanoMeter " + num(c.slice_thickness_nm) + "; expected " + thickness_expected);
+  if (!whole(c.dpi_x) || !whole(c.dpi_y))
+    bad("XDpi, YDpi " + num(c.dpi_x) + ", " + num(c.dpi_y) + "; expected whole dots per inch (readers take integers)");
+  if (!whole(c.slice_thickness_nm))
+    bad("SliceThicknessNanoMeter " + num(c.slice_thickness_nm) + "; expected a whole number of nanometres (readers take an integer)");
+  if (c.max_colors < 1) bad("MaxNumberOfColors " + std::to_string(c.max_colors) + "; expected 1 or more");
+  if (static_cast<int>(c.materials.size()) > c.max_colors) {
+    std::string names;
+    for (const StackMaterial& m : c.materials) names += (names.empty() ? "" : ", ") + m.name;
+    bad("MaterialList: " + std::to_string(c.materials.size()) + " materials (" + names + "); expected at most " +
+        std::to_string(c.max_colors) + ", the printer's MaxNumberOfColors");
+  }
   if (c.width < 1 || c.width > max_pixels) bad("SliceWidth " + std::to_string(c.width) + "; expected " + size_expected);
   if (c.height < 1 || c.height > max_pixels) bad("SliceHeight " + std::to_string(c.height) + "; expected " + size_expected);
   if (c.start_index < 0) bad("StartIndex " + std::to_string(c.start_index) + "; expected 0 or more");
@@ -219,6 +228,18 @@ void text_child(pugi::xml_node parent, const char* name, const std::string& valu
 
 }  // namespace
 
+std::array<std::uint8_t, 4> stack_background(std::string_view name) {
+  if (name == "transparent") return {0, 0, 0, 0};
+  if (name == "black") return {0, 0, 0, 255};
+  throw Error("--background " + std::string(name) + ": unknown; expected transparent or black");
+}
+
+std::string stack_background_name(const std::array<std::uint8_t, 4>& rgba) {
+  if (rgba == std::array<std::uint8_t, 4>{0, 0, 0, 0}) return "transparent";
+  if (rgba == std::array<std::uint8_t, 4>{0, 0, 0, 255}) return "black";
+  return detail::rgba_text(rgba.data());
+}
+
 std::string config_xml(const StackConfig& c) {
   check_config(c);
   pugi::xml_document doc;
@@ -229,9 +250,9 @@ std::string config_xml(const StackConfig& c) {
   pugi::xml_node root = doc.append_child("GCVF");
   text_child(root, "Version", std::to_string(c.version));
   pugi::xml_node res = root.append_child("Resolution");
-  text_child(res, "XDpi", decimal(c.dpi_x));
-  text_child(res, "YDpi", decimal(c.dpi_y));
-  text_child(res, "SliceThicknessNanoMeter", decimal(c.slice_thickness_nm));
+  text_child(res, "XDpi", integer(c.dpi_x));
+  text_child(res, "YDpi", integer(c.dpi_y));
+  text_child(res, "SliceThicknessNanoMeter", integer(c.slice_thickness_nm));
   pugi::xml_node dims = root.append_child("SliceDimensions");
   text_child(dims, "SliceWidth", std::to_string(c.width));
   text_child(dims, "SliceHeight", std::to_string(c.height));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
@@ -176,18 +177,31 @@ std::string option_number(double v) {
   return std::string(buf, r.ptr);
 }
 
+double whole_if_near(double v) {
+  const double r = std::round(v);
+  return std::abs(v - r) <= 1e-6 ? r : v;
+}
+
 io::StackConfig stack_config_of(const Manifest& m, const std::vector<std::int64_t>& totals) {
   io::StackConfig cfg;
-  cfg.dpi_x = m.dpi_x;
-  cfg.dpi_y = m.dpi_y;
-  cfg.slice_thickness_nm = m.layer_mm * 1e6;
+  // The job checked that these are whole (slice_job: voxel_print_numbers); the rounding only
+  // drops the binary noise of layer_mm * 1e6 (0.027 mm is 27000.000000000004 nm).
+  cfg.dpi_x = whole_if_near(m.dpi_x);
+  cfg.dpi_y = whole_if_near(m.dpi_y);
+  cfg.slice_thickness_nm = whole_if_near(m.layer_mm * 1e6);
   cfg.width = m.grid[0];
   cfg.height = m.grid[1];
   cfg.slices = m.grid[2];
-  cfg.digits = std::max(5, static_cast<int>(std::to_string(m.grid[2]).size()));
-  for (std::size_t i = 0; i < m.materials.size(); ++i)
-    cfg.materials.push_back({m.materials[i], i < m.colours.size() ? m.colours[i] : std::array<std::uint8_t, 4>{},
-                             i < totals.size() ? totals[i] : 0});
+  const auto option = [&](const char* key, const char* otherwise) {
+    const auto it = m.options.find(key);
+    return it != m.options.end() ? it->second : std::string(otherwise);
+  };
+  cfg.digits = std::stoi(option("png.digits", "0"));
+  cfg.background = io::stack_background(option("png.background", "transparent"));
+  cfg.max_colors = std::stoi(option("png.channels", "6"));
+  for (std::size_t i = 0; i < m.materials.size() && i < totals.size(); ++i)
+    if (totals[i] > 0)
+      cfg.materials.push_back({m.materials[i], i < m.colours.size() ? m.colours[i] : std::array<std::uint8_t, 4>{}, totals[i]});
   return cfg;
 }
 
@@ -236,6 +250,20 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
   const auto& opts = r.member(root, "", "options");
   if (!opts.is_object()) r.fail_type("/options", opts, "an object of strings");
   for (const auto& [k, v] : opts.items()) m.options[k] = r.string(v, "/options/" + k);
+  if (m.options.count("png") && m.options.at("png") == "yes") {
+    // What trivox wrote before these options were recorded: zero-padded names of 5 digits,
+    // transparent void, MaxNumberOfColors 6.
+    m.options.try_emplace("png.digits", "5");
+    m.options.try_emplace("png.background", "transparent");
+    m.options.try_emplace("png.channels", "6");
+    const std::string& d = m.options.at("png.digits");
+    if (d.size() != 1 || d[0] < '0' || d[0] > '9') r.fail_type("/options/png.digits", opts.at("png.digits"), "a digit count 0..9");
+    const std::string& b = m.options.at("png.background");
+    if (b != "transparent" && b != "black") r.fail_type("/options/png.background", opts.at("png.background"), "\"transparent\" or \"black\"");
+    const std::string& c = m.options.at("png.channels");
+    if (c.empty() || c.size() > 3 || !std::all_of(c.begin(), c.end(), [](char ch) { return ch >= '0' && ch <= '9'; }) || std::stoi(c) < 1)
+      r.fail_type("/options/png.channels", opts.at("png.channels"), "a material count 1..999");
+  }
   const auto& grid = r.array(r.member(root, "", "grid"), "/grid", "3 voxel counts");
   if (grid.size() != 3) r.fail_type("/grid", grid, "an array of 3 voxel counts");
   for (std::size_t d = 0; d < 3; ++d)

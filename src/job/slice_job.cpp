@@ -62,6 +62,23 @@ void check_profile(const slice::PrintProfile& p) {
     throw Error("--layer " + text(p.layer_mm) + ": out of range; expected a layer of 0.001 to 10 mm");
 }
 
+/// ConfigFile.xml holds the resolution and the layer as integers (dots per inch, nanometres),
+/// and every reader parses them so: a job whose numbers are not whole would be printed at
+/// another size. The layer allows the binary noise of mm * 1e6 (0.027 mm is 27000.000000000004).
+void check_voxel_print_numbers(const slice::PrintProfile& p) {
+  if (p.dpi_x != std::floor(p.dpi_x) || p.dpi_y != std::floor(p.dpi_y))
+    throw Error("--dpi " + text(p.dpi_x) + "," + text(p.dpi_y) +
+                ": not whole dots per inch; expected integers (ConfigFile.xml's XDpi and YDpi are integers), e.g. 600,300");
+  const double nm = p.layer_mm * 1e6;
+  if (std::abs(nm - std::round(nm)) > 1e-6) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.10g", nm);
+    throw Error("--layer " + text(p.layer_mm) + ": " + buf +
+                " nm, not a whole number of nanometres; expected a layer of whole nanometres (ConfigFile.xml's "
+                "SliceThicknessNanoMeter is an integer), e.g. 0.027");
+  }
+}
+
 bool is_manifest_name(const std::string& name) {
   return name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json"));
 }
@@ -232,11 +249,30 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
                   " voxels (raise --max-voxels or use --force)");
   }
 
+  check_voxel_print_numbers(opt.profile);
+  if (opt.digits < 0 || opt.digits > 9)
+    throw Error("--digits " + std::to_string(opt.digits) + ": out of range; expected 0 (no padding: slice_7.png) to 9");
+  const std::array<std::uint8_t, 4> background = io::stack_background(opt.background);
+
   // The PNG module now (png_codec.hpp): when it cannot be loaded the job stops here, before a
   // folder is made or a layer sampled.
   (void)io::detail::png_codec();
 
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
+  const std::string palette_source = opt.palette ? opt.palette->string() : std::string("the built-in palette");
+  if (static_cast<int>(palette.materials.size()) > opt.profile.channels) {
+    std::string names;
+    for (const auto& m : palette.materials) names += (names.empty() ? "" : ", ") + m.name;
+    throw Error(palette_source + ": " + std::to_string(palette.materials.size()) + " materials (" + names + "); the " +
+                opt.profile.name + " holds " + std::to_string(opt.profile.channels) +
+                " at once; expected a palette of at most " + std::to_string(opt.profile.channels) +
+                " materials (or a printer with more channels)");
+  }
+  for (const auto& m : palette.materials)
+    if (m.rgba == background)
+      throw Error(palette_source + ": material " + m.name + " is coloured " + io::detail::rgba_text(m.rgba.data()) +
+                  ", the void colour of --background " + opt.background +
+                  "; expected material colours other than the background (or --background transparent)");
   const slice::MaterialMapper mapper(palette, model.properties, opt.palette ? opt.palette->string() : std::string());
   const slice::DitherMode mode = slice::parse_dither_mode(opt.dither);
 
@@ -251,8 +287,11 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const int band_rows = std::max(1, std::min(opt.band_rows, ny));
 
 
-  // Pixel colours by material index; 255 (void) and unused indices are transparent black.
+  // Pixel colours by material index; 255 (void) and unused indices are the background.
   std::array<std::uint32_t, 256> colour{};
+  std::uint32_t void_colour = 0;
+  std::memcpy(&void_colour, background.data(), 4);
+  colour.fill(void_colour);
   for (int m = 0; m < nmat; ++m) std::memcpy(&colour[static_cast<std::size_t>(m)], palette.materials[static_cast<std::size_t>(m)].rgba.data(), 4);
 
   // The job's identity and the folder; when resuming, the layers that are done and verify.
@@ -268,6 +307,9 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   manifest.options["png.palette"] = palette.name + (opt.palette ? " " + io::sha256_file(*opt.palette) : std::string(" (built in)"));
   manifest.options["png.dither"] = std::string(slice::dither_mode_name(mode));
   manifest.options["png.zip"] = opt.zip ? "yes" : "no";
+  manifest.options["png.digits"] = std::to_string(opt.digits);
+  manifest.options["png.background"] = opt.background;
+  manifest.options["png.channels"] = std::to_string(opt.profile.channels);
   manifest.grid = grid.count;
   manifest.dpi_x = opt.profile.dpi_x;
   manifest.dpi_y = opt.profile.dpi_y;

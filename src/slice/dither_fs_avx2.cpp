@@ -70,7 +70,7 @@ template <int MC>
     const float* e = in + static_cast<std::ptrdiff_t>(x) * S;
     float* d_back = down + static_cast<std::ptrdiff_t>(x - dir) * S;
     if (cell[x] < 0) {
-      std::memset(rgba + 4 * static_cast<std::ptrdiff_t>(x), 0, 4);
+      std::memcpy(rgba + 4 * static_cast<std::ptrdiff_t>(x), &colours[void_material], 4);
       store8(d_back, acc_here);
       acc_here = acc_fwd;
       acc_fwd = V8{};

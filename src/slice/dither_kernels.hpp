@@ -102,7 +102,7 @@ struct ColourIO {
     f[1] = V4{c[4], 0.0f, 0.0f, 0.0f};
   }
   void put(int x, int best) const noexcept { std::memcpy(rgba + 4 * static_cast<std::ptrdiff_t>(x), &colours[best], 4); }
-  void put_void(int x) const noexcept { std::memset(rgba + 4 * static_cast<std::ptrdiff_t>(x), 0, 4); }
+  void put_void(int x) const noexcept { std::memcpy(rgba + 4 * static_cast<std::ptrdiff_t>(x), &colours[void_material], 4); }
 };
 
 /// The fs weights per neighbour-availability mask (forward, down_back, down, down_forward),

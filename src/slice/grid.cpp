@@ -9,8 +9,11 @@
 namespace trivox::slice {
 
 namespace {
-PrintProfile polyjet(std::string name) {
+/// Stratasys' PolyJet printers of the J series that Voxel Print serves: the same resolution and
+/// tray; the J750 holds 6 model materials at once, the J850 7 (their product specifications).
+PrintProfile polyjet(std::string name, int channels) {
   PrintProfile p;
+  p.channels = channels;
   p.name = std::move(name);
   p.dpi_x = 600.0;
   p.dpi_y = 300.0;
@@ -24,7 +27,7 @@ std::vector<std::string> printer_presets() { return {"j750", "j850"}; }
 
 PrintProfile printer_preset(std::string_view name) {
   for (const auto& known : printer_presets())
-    if (name == known) return polyjet(known);
+    if (name == known) return polyjet(known, known == "j850" ? 7 : 6);
   std::string list;
   for (const auto& known : printer_presets()) list += (list.empty() ? "" : ", ") + known;
   throw Error("--printer " + std::string(name) + ": unknown printer; expected one of " + list);

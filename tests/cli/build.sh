@@ -40,7 +40,7 @@ assert t["v_curves"] == 12 + 32 + 32 + 20 + 32 and t["v_points"] == 8 + 16 + 16 
 PY
 
 # A coarse slice: voxels x voxel volume ~ the analytic volume.
-"$trivox" slice "$tmp/m.json" -o "$tmp/slice" --dpi 35,35 --layer 0.7257142857142857 --threads 2 --progress never --json > "$tmp/slice.json"
+"$trivox" slice "$tmp/m.json" -o "$tmp/slice" --dpi 35,35 --layer 0.725714 --threads 2 --progress never --json > "$tmp/slice.json"
 "$py" - "$tmp/slice.json" <<'PY'
 import sys, json, math
 s = json.load(open(sys.argv[1]))

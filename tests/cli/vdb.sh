@@ -201,14 +201,15 @@ assert interior and all(values[c] == 1 for c in interior)
 PY
 
 # --- Colours and fractions against trivox locate; both outputs at once -----------------------
-"$trivox" slice models/graded_block.json -o "$tmp/g1" --png --vdb --dpi 25.4,25.4 --layer 1 --vdb-voxel 1 --threads 1 $q --json > "$tmp/g1.json"
-"$trivox" slice models/graded_block.json -o "$tmp/g2" --vdb --vdb-voxel 1 --threads 2 $q > /dev/null
+# 25 dpi is 1.016 mm: the PNG stack's voxels are cubes of the VDB's voxel size.
+"$trivox" slice models/graded_block.json -o "$tmp/g1" --png --vdb --dpi 25,25 --layer 1.016 --vdb-voxel 1.016 --threads 1 $q --json > "$tmp/g1.json"
+"$trivox" slice models/graded_block.json -o "$tmp/g2" --vdb --vdb-voxel 1.016 --threads 2 $q > /dev/null
 cmp "$tmp/g1/graded_block.vdb" "$tmp/g2/graded_block.vdb"
 # The PNG stack written with the VDB (the model's box measured once for both jobs) is the stack
 # written alone.
-"$trivox" slice models/graded_block.json -o "$tmp/g3" --dpi 25.4,25.4 --layer 1 --threads 2 $q > /dev/null
+"$trivox" slice models/graded_block.json -o "$tmp/g3" --dpi 25,25 --layer 1.016 --threads 2 $q > /dev/null
 for f in "$tmp"/g3/slice_*.png "$tmp/g3/ConfigFile.xml"; do cmp "$f" "$tmp/g1/$(basename "$f")"; done
-[ -f "$tmp/g1/ConfigFile.xml" ] && [ -f "$tmp/g1/slice_00000.png" ]
+[ -f "$tmp/g1/ConfigFile.xml" ] && [ -f "$tmp/g1/slice_0.png" ]
 "$py" - "$tmp/g1" <<'PY'
 import sys, json, hashlib, os
 d = sys.argv[1]
@@ -216,7 +217,7 @@ m = json.load(open(os.path.join(d, "manifest.json")))      # the job's manifest 
 vdb = [f for f in m["files"] if f["role"] == "vdb"]
 assert m["complete"] and len(vdb) == 1 and vdb[0]["file"] == "graded_block.vdb", m["files"]
 assert vdb[0]["sha256"] == hashlib.sha256(open(os.path.join(d, "graded_block.vdb"), "rb").read()).hexdigest()
-assert m["options"]["vdb"] == "yes" and m["options"]["vdb.voxel_mm"] == "1" and m["options"]["vdb.supersample"] == "1", m["options"]
+assert m["options"]["vdb"] == "yes" and m["options"]["vdb.voxel_mm"] == "1.016" and m["options"]["vdb.supersample"] == "1", m["options"]
 PY
 "$py" - "$tmp/g1/graded_block.vdb" "$tmp/g1.json" "$trivox" models/graded_block.json <<'PY'
 import sys, json, subprocess
@@ -225,9 +226,9 @@ path, summary, trivox, model = sys.argv[1], json.load(open(sys.argv[2])), sys.ar
 grids, meta = vdb.readAll(path)
 g = {x.name: x for x in grids}
 dens = {tuple(it["min"]): it["value"] for it in g["density"].citerOnValues()}
-# Same grid as the 1 mm PNG stack (origin and pitch): the same voxels are filled.
+# Same grid as the 1.016 mm PNG stack (origin and pitch): the same voxels are filled.
 assert len(dens) == summary["filled"] == summary["vdb"]["active_voxels"], (len(dens), summary["filled"])
-assert abs(len(dens) - 9600) / 9600 < 0.03
+assert abs(len(dens) - 9600 / 1.016**3) / 9600 < 0.03
 color = {tuple(it["min"]): it["value"] for it in g["color"].citerOnValues()}
 assert set(color) == set(dens)
 palette = ["VeroCyan-V", "VeroMagenta-V", "VeroYellow-V", "VeroBlack", "VeroUltraWhite", "UltraClear"]

@@ -85,7 +85,8 @@ import OpenImageIO as oiio
 
 def stack(d):
     out = []
-    for path in sorted(glob.glob(os.path.join(d, "slice_*.png"))):
+    layer = lambda p: int(os.path.basename(p)[len("slice_"):-len(".png")])
+    for path in sorted(glob.glob(os.path.join(d, "slice_*.png")), key=layer):
         inp = oiio.ImageInput.open(path)
         px = inp.read_image(format="uint8")
         inp.close()

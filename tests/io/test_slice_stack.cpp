@@ -62,8 +62,11 @@ std::map<Rgba, std::int64_t> census(const std::vector<std::uint8_t>& px) {
 }
 
 /// Writes a stack of `n` test slices with correct VoxelCounts; returns the config.
+/// A stack with zero-padded names (slice_00000.png), as `--digits 5` and earlier trivox write:
+/// the readers must take both forms.
 StackConfig write_test_stack(const fs::path& dir, int w, int h, int n) {
   StackConfig c = three_materials(w, h, n);
+  c.digits = 5;
   std::map<Rgba, std::int64_t> total;
   for (int k = 0; k < n; ++k) {
     const auto px = test_slice(w, h, k);
@@ -253,6 +256,10 @@ TEST_CASE("decode_png_rgba gives RGB files alpha 255", "[io][stack][png]") {
 
 TEST_CASE("slice names", "[io][stack]") {
   StackConfig c;
+  // Unpadded by default, as the public writers name slices.
+  CHECK(c.slice_name(0) == "slice_0.png");
+  CHECK(c.slice_name(123456) == "slice_123456.png");
+  c.digits = 5;
   CHECK(c.slice_name(0) == "slice_00000.png");
   c.start_index = 7;
   CHECK(c.slice_name(5) == "slice_00012.png");
@@ -267,7 +274,7 @@ TEST_CASE("slice names", "[io][stack]") {
 
 TEST_CASE("ConfigFile.xml round trip, and what pugixml reads in it", "[io][stack][xml]") {
   StackConfig c = three_materials(11575, 4606, 7411);
-  c.dpi_x = 599.5;
+  c.dpi_x = 1200;
   c.start_index = 3;
   c.prefix = "layer_";
   c.materials[0].voxel_count = 123456789012LL;
@@ -281,7 +288,7 @@ TEST_CASE("ConfigFile.xml round trip, and what pugixml reads in it", "[io][stack
   const pugi::xml_node root = doc.child("GCVF");
   REQUIRE(root);
   CHECK(root.child("Version").text().as_int() == 2);
-  CHECK(std::string(root.child("Resolution").child_value("XDpi")) == "599.5");
+  CHECK(std::string(root.child("Resolution").child_value("XDpi")) == "1200");
   CHECK(std::string(root.child("Resolution").child_value("YDpi")) == "300");
   CHECK(std::string(root.child("Resolution").child_value("SliceThicknessNanoMeter")) == "27000");
   CHECK(root.child("SliceDimensions").child("SliceWidth").text().as_int() == 11575);
@@ -313,6 +320,44 @@ TEST_CASE("ConfigFile.xml round trip, and what pugixml reads in it", "[io][stack
     CHECK(std::string(res.child_value("XDpi")) == "100000");
     CHECK(std::string(res.child_value("YDpi")) == "20000");
     CHECK(parse_config_xml(config_xml(c), "ConfigFile.xml") == c);
+  }
+
+  SECTION("numbers that are not whole are refused, not written as 1000.9999999999999") {
+    // What parseInt (voxelprint-preview) or int() would make of them: another resolution.
+    StackConfig f = c;
+    f.dpi_x = 599.5;
+    check_message(error_of([&] { config_xml(f); }), {"XDpi, YDpi 599.5, 300", "expected whole dots per inch"});
+    f = c;
+    f.slice_thickness_nm = 0.001001 * 1e6;  // binary noise: the job rounds it (stack_config_of) first
+    check_message(error_of([&] { config_xml(f); }),
+                  {"SliceThicknessNanoMeter 1000.9999999999999", "expected a whole number of nanometres"});
+  }
+
+  SECTION("MaxNumberOfColors bounds the material list") {
+    StackConfig f = c;
+    f.max_colors = 2;
+    check_message(error_of([&] { config_xml(f); }),
+                  {"MaterialList: 3 materials (VeroCyan-V, VeroMagenta-V, A&B <white> \"x\")", "expected at most 2"});
+    f.max_colors = 7;
+    pugi::xml_document d2;
+    REQUIRE(d2.load_string(config_xml(f).c_str()));
+    CHECK(d2.child("GCVF").child("MaxNumberOfColors").text().as_int() == 7);
+    CHECK(parse_config_xml(config_xml(f), "ConfigFile.xml") == f);
+  }
+
+  SECTION("a black background: declared, read back, and no material may be black") {
+    StackConfig f = c;
+    f.background = stack_background("black");
+    CHECK(f.background == Rgba{0, 0, 0, 255});
+    CHECK(stack_background_name(f.background) == "black");
+    CHECK(stack_background_name(stack_background("transparent")) == "transparent");
+    pugi::xml_document d2;
+    REQUIRE(d2.load_string(config_xml(f).c_str()));
+    CHECK(std::string(d2.child("GCVF").child("MaterialList").child_value("BackGroundMaterialRGBA")) == "0 0 0 255");
+    CHECK(parse_config_xml(config_xml(f), "ConfigFile.xml") == f);
+    f.materials[1].rgba = Rgba{0, 0, 0, 255};
+    check_message(error_of([&] { config_xml(f); }), {"is the background colour", "expected a colour of its own"});
+    check_message(error_of([&] { stack_background("white"); }), {"--background white: unknown; expected transparent or black"});
   }
 
   SECTION("a flat layout (elements directly under the root) reads too") {

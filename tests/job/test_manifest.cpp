@@ -12,6 +12,7 @@
 using namespace trivox;
 using namespace trivox::io;
 using namespace trivox::job;
+using trivox::io::test::check_message;
 using trivox::io::test::error_of;
 
 namespace {
@@ -174,4 +175,42 @@ TEST_CASE("malformed manifests are refused with the place and what was expected"
   CHECK_THAT(edit("\"index\": 8", "\"index\": 7"), Catch::Contains("/layers/0/index"));   // outside the range
   CHECK_THAT(edit("\"layer_range\": [\n    8,", "\"layer_range\": [\n    -1,"), Catch::Contains("/layer_range/0"));
   CHECK_THAT(edit("\"voxels\": [\n        8,", "\"voxels\": [\n"), Catch::Contains("/layers/0/voxels: found an array of 1"));
+}
+
+TEST_CASE("a PNG job's manifest records names, void and channels; earlier ones read as what they were", "[manifest]") {
+  Manifest m = sample();
+  m.options["png"] = "yes";
+  SECTION("a manifest without them is one of the padded, transparent stacks of earlier trivox") {
+    const Manifest back = parse_manifest(manifest_json(m), "manifest.json");
+    CHECK(back.options.at("png.digits") == "5");
+    CHECK(back.options.at("png.background") == "transparent");
+    CHECK(back.options.at("png.channels") == "6");
+    const io::StackConfig c = stack_config_of(back, {});
+    CHECK(c.slice_name(0) == "slice_00000.png");
+    CHECK(c.background == std::array<std::uint8_t, 4>{0, 0, 0, 0});
+  }
+  SECTION("recorded values drive the ConfigFile.xml, which lists the used materials only") {
+    m.options["png.digits"] = "0";
+    m.options["png.background"] = "black";
+    m.options["png.channels"] = "7";
+    m.layer_mm = 0.001001;  // 1000.9999999999999 nm in binary: written as 1001
+    const io::StackConfig c = stack_config_of(parse_manifest(manifest_json(m), "manifest.json"), {0, 42});
+    CHECK(c.slice_name(7) == "slice_7.png");
+    CHECK(c.background == std::array<std::uint8_t, 4>{0, 0, 0, 255});
+    CHECK(c.max_colors == 7);
+    CHECK(c.slice_thickness_nm == 1001);
+    REQUIRE(c.materials.size() == 1);
+    CHECK(c.materials[0].name == "VeroBlack");
+    CHECK(c.materials[0].voxel_count == 42);
+    CHECK(io::config_xml(c).find("<SliceThicknessNanoMeter>1001</SliceThicknessNanoMeter>") != std::string::npos);
+  }
+  SECTION("malformed values are refused with their place") {
+    m.options["png.digits"] = "12";
+    check_message(error_of([&] { parse_manifest(manifest_json(m), "m.json"); }),
+                  {"m.json: /options/png.digits: found the string \"12\"; expected a digit count 0..9"});
+    m.options["png.digits"] = "0";
+    m.options["png.background"] = "white";
+    check_message(error_of([&] { parse_manifest(manifest_json(m), "m.json"); }),
+                  {"/options/png.background", "expected \"transparent\" or \"black\""});
+  }
 }

@@ -3,8 +3,10 @@
 /// it from a stack folder, and the slice file names it implies.
 ///
 /// A stack is a folder holding `ConfigFile.xml` and one 8-bit RGBA PNG per layer, named
-/// `<ImageFilePrefix><zero-padded index>.png` (docs/slice-output.md is the full reference). Every
-/// pixel is one material's palette colour, or void (alpha 0). Image column i is x, image row r
+/// `<ImageFilePrefix><index>.png`, the index unpadded as the public writers name them
+/// (`slice_0.png`; zero padding on request) (docs/slice-output.md is the full reference). Every
+/// pixel is one material's palette colour, or void: the background colour the file declares
+/// (transparent `0 0 0 0` or opaque black `0 0 0 255`). Image column i is x, image row r
 /// holds j = ny - 1 - r (slice/grid.hpp): a slice viewed top-down shows the layer from +z, +y up.
 ///
 /// `ConfigFile.xml` follows the layout GrabCAD Voxel Print writes and reads (root `<GCVF>`,
@@ -37,20 +39,27 @@ struct StackMaterial {
 /// What `ConfigFile.xml` says about a stack.
 struct StackConfig {
   int version = 2;                        ///< `Version`: 2 is what Voxel Print files carry
-  double dpi_x = 600, dpi_y = 300;        ///< `XDpi`, `YDpi`: pixels per inch along x (columns), y (rows)
-  double slice_thickness_nm = 27000;      ///< `SliceThicknessNanoMeter`: layer thickness
+  /// `XDpi`, `YDpi`: pixels per inch along x (columns), y (rows). Whole numbers to be written
+  /// (every reader parses them as integers); a file read may hold fractions.
+  double dpi_x = 600, dpi_y = 300;
+  double slice_thickness_nm = 27000;      ///< `SliceThicknessNanoMeter`: layer thickness; idem
   int width = 0, height = 0;              ///< `SliceWidth`, `SliceHeight`: pixels per slice
   int start_index = 0, slices = 0;        ///< `StartIndex`, `NumberOfSlices`
   std::string prefix = "slice_";          ///< `ImageFilePrefix`
   /// Zero padding of the index in file names (not in the XML: inspect_stack and read_stack_config
-  /// find it from the folder). 0 or less: no padding.
-  int digits = 5;
+  /// find it from the folder). 0 or 1: none (`slice_7.png`), as the public writers name slices.
+  int digits = 0;
   int bit_depth = 4;                      ///< `BitDepth`: written as Voxel Print files carry it
-  int max_colors = 6;                     ///< `MaxNumberOfColors`: idem
+  /// `MaxNumberOfColors`: the materials the printer holds at once (slice::PrintProfile::channels);
+  /// the `MaterialList` may not list more.
+  int max_colors = 6;
   std::string data_semantics = "Materials";  ///< `DataSemantics`
   std::string creation_mode = "MODEL_ONLY";  ///< `CreationMode`
-  std::array<std::uint8_t, 4> background{0, 0, 0, 0};  ///< `BackGroundMaterialRGBA`: the void colour
-  std::vector<StackMaterial> materials;   ///< `MaterialList`, in file order
+  /// `BackGroundMaterialRGBA`: the void colour, painted in every slice where there is no
+  /// material (stack_background: transparent or black).
+  std::array<std::uint8_t, 4> background{0, 0, 0, 0};
+  /// `MaterialList`, in file order: the materials the stack uses (a voxel count above 0).
+  std::vector<StackMaterial> materials;
 
   /// File name of slice i (0-based position in the stack): prefix + (start_index + i) padded
   /// with zeros to `digits` + ".png". Indices wider than `digits` are written in full.
@@ -63,6 +72,13 @@ struct StackConfig {
   friend bool operator==(const StackConfig&, const StackConfig&) = default;
 };
 
+/// The void colours a stack may declare, by name: "transparent" (`0 0 0 0`, as OpenVCAD's
+/// exporter writes) and "black" (`0 0 0 255`, as slice2vox writes and voxelprint-preview reads).
+/// @throws trivox::Error (bad_input) "--background NAME: unknown; expected transparent or black"
+std::array<std::uint8_t, 4> stack_background(std::string_view name);
+/// The name of a void colour stack_background knows ("transparent", "black"), else "r g b a".
+std::string stack_background_name(const std::array<std::uint8_t, 4>& rgba);
+
 /// `ConfigFile.xml` text for `config` (UTF-8, 2-space indented; names are XML-escaped):
 /// ```
 /// <GCVF>
@@ -74,7 +90,11 @@ struct StackConfig {
 ///     <Material><Name/><RGBA>r g b a</RGBA><VoxelCount/></Material>...</MaterialList>
 /// </GCVF>
 /// ```
-/// Numbers are written in the shortest form that reads back to the same double.
+/// Every number is written as an integer, as every reader parses them.
+/// @throws trivox::Error (bad_input) for a config a reader would misread: a resolution or layer
+///         thickness that is not a whole number (of dots per inch, of nanometres), more materials
+///         than `max_colors` (listing them), a material coloured like the background, and the
+///         ranges of parse_config_xml
 std::string config_xml(const StackConfig& config);
 
 /// Parses `ConfigFile.xml` text. Elements are found by name anywhere below the root (older and

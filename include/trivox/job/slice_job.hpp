@@ -43,6 +43,13 @@ struct SliceJobOptions {
   std::string dither = "fs";                   ///< fs, stochastic or none
   bool force = false;                          ///< write into a non-empty folder, exceed the limits
   bool zip = false;                            ///< also pack the folder as <out_dir>.gcvf
+  /// Zero padding of the slice numbers in file names: 0 (the default) names them as the public
+  /// Voxel Print writers do, `slice_0.png`, `slice_1.png`; 5 gives `slice_00000.png`. 0..9.
+  int digits = 0;
+  /// The void colour (io::stack_background): "transparent" (0 0 0 0) or "black" (0 0 0 255);
+  /// ConfigFile.xml declares it as BackGroundMaterialRGBA. With "black", a palette material
+  /// coloured 0 0 0 255 is refused.
+  std::string background = "transparent";
   std::int64_t max_voxels = 100'000'000'000;   ///< refuse larger grids unless force
   int band_rows = 64;                          ///< rows sampled and dithered at a time
   slice::SamplerOptions sampler;               ///< sampling options (the Shepard blend, --blend)
@@ -113,7 +120,9 @@ std::optional<Manifest> prepare_job_folder(const std::filesystem::path& dir, con
 /// @throws Error (bad_input) when the manifest is missing or malformed; (failed) when writing fails
 void finish_manifest(const std::filesystem::path& dir, const Shard& shard, const std::vector<ManifestFile>& files);
 
-/// Runs the job. @throws Error (bad_input) for bad options, an unusable output folder, a job
+/// Runs the job. @throws Error (bad_input) for bad options (among them a resolution or layer
+/// that is not a whole number of dots per inch or nanometres, which ConfigFile.xml cannot hold,
+/// and a palette of more materials than the printer's channels), an unusable output folder, a job
 /// larger than the tray or max_voxels (unless force), a malformed palette; (failed) when the PNG
 /// module cannot be loaded (checked before the folder is made) or writing fails midway.
 SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions& options,

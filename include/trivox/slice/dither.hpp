@@ -96,7 +96,7 @@ public:
   /// @param cell     nx values; < 0 marks a void voxel
   /// @param props    nx * mapper.properties() floats, voxel-major (RowBand::props)
   /// @param mapper   the job's mapper; mapper.materials() == materials()
-  /// @param colours  RGBA of each material index, 4 bytes each (index 255: void, 0 0 0 0)
+  /// @param colours  RGBA of each material index, 4 bytes each (index 255: void, the stack's background colour)
   /// @param rgba     nx * 4 bytes written
   /// @param counts   materials() counters: each gets the number of voxels of that material added
   void dither_paint(int row, const std::int32_t* cell, const float* props, const MaterialMapper& mapper,

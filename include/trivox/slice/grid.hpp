@@ -25,13 +25,17 @@ struct PrintProfile {
   double dpi_x = 600.0, dpi_y = 300.0;  ///< pixels per inch along x (image columns) and y (rows)
   double layer_mm = 0.027;              ///< layer thickness
   std::array<double, 3> tray_mm{490.0, 390.0, 200.0};
+  /// Model materials the printer holds at once: the most one job may use (ConfigFile.xml's
+  /// `MaxNumberOfColors`). 6 on the J750, 7 on the J850 (Stratasys' product specifications).
+  int channels = 6;
 
   double pitch_x() const noexcept { return 25.4 / dpi_x; }
   double pitch_y() const noexcept { return 25.4 / dpi_y; }
   double pitch_z() const noexcept { return layer_mm; }
 };
 
-/// Known presets: "j750", "j850" (600 x 300 dpi, 27 um layers, tray 490 x 390 x 200 mm).
+/// Known presets: "j750", "j850" (600 x 300 dpi, 27 um layers, tray 490 x 390 x 200 mm; 6 and
+/// 7 model materials at once).
 /// @throws Error (bad_input) for an unknown name, listing the known ones
 PrintProfile printer_preset(std::string_view name);
 /// Names accepted by printer_preset.
