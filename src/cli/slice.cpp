@@ -30,6 +30,7 @@ struct Options {
   double max_voxels = 1e11;  // a double, so that 1e9 reads as the help writes it
   bool png = false, vdb = false;
   double vdb_voxel = 0.0;
+  std::string vdb_units = "mm", vdb_color_space = "linear";
   int supersample = 1;
   bool resume = false;
   std::string shard;
@@ -110,6 +111,8 @@ nlohmann::ordered_json vdb_json(const job::VdbJobSummary& v) {
           {"volume_mm3", v.volume_mm3},
           {"estimated_volume_mm3", v.plan.estimated_volume_mm3},
           {"colour_source", v.colour_source},
+          {"units", v.units},
+          {"color_space", v.color_space},
           {"palette", v.palette},
           {"materials", mats},
           {"inversion_failures", v.inversion_failures},
@@ -136,8 +139,10 @@ void print_vdb(const job::VdbJobSummary& v) {
   std::printf("active voxels %lld (%lld fractional), volume %s mm^3 (quadrature %s mm^3)\n",
               static_cast<long long>(v.active_voxels), static_cast<long long>(v.fractional_voxels),
               fmt(v.volume_mm3, 8).c_str(), fmt(p.estimated_volume_mm3, 8).c_str());
-  std::printf("colour from %s; material volumes (fractions before dithering, palette %s):\n",
-              v.colour_source == "r,g,b" ? "the model's r, g, b" : "the palette colours", v.palette.c_str());
+  if (v.units != "mm") std::printf("world unit %s (the grids' transform: mm / 1000)\n", v.units.c_str());
+  std::printf("colour from %s, %s; material volumes (fractions before dithering, palette %s):\n",
+              v.colour_source == "r,g,b" ? "the model's r, g, b" : "the palette colours",
+              v.color_space == "srgb" ? "sRGB-encoded" : "linear", v.palette.c_str());
   for (std::size_t m = 0; m < v.materials.size(); ++m)
     if (v.material_volume_mm3[m] > 0)
       std::printf("  %-16s %14.3f mm^3\n", v.materials[m].c_str(), v.material_volume_mm3[m]);
@@ -166,6 +171,10 @@ void add_slice(CLI::App& app, Common& common) {
   sub->add_flag("--png", opt->png, "Write the PNG stack (the default without --vdb)");
   sub->add_flag("--vdb", opt->vdb, "Write the OpenVDB volume DIR/<model>.vdb (with --png: both)");
   sub->add_option("--vdb-voxel", opt->vdb_voxel, "VDB voxel edge in mm (default: about 5e7 active voxels)");
+  sub->add_option("--vdb-units", opt->vdb_units,
+                  "VDB world unit: mm (default; OpenVDB's tools) or m (Blender, Houdini: the transform / 1000)");
+  sub->add_option("--vdb-color-space", opt->vdb_color_space,
+                  "VDB color/Cd values: linear (default; what renderers expect) or srgb (the encoded colours)");
   sub->add_option("--supersample", opt->supersample, "VDB: N^3 samples per voxel for fractional density, 1..8 (default 1)");
   sub->add_flag("--resume", opt->resume, "Continue the job in DIR: keep the layers its manifest lists and that verify");
   sub->add_option("--shard", opt->shard, "Slice only part K of N of the layers (K from 0: 0/3, 1/3, 2/3); see trivox merge");
@@ -174,7 +183,7 @@ void add_slice(CLI::App& app, Common& common) {
   sub->callback([opt, &common, sub] {
     const bool want_vdb = opt->vdb, want_png = opt->png || !opt->vdb;
     if (!want_vdb)
-      for (const char* o : {"--vdb-voxel", "--supersample"})
+      for (const char* o : {"--vdb-voxel", "--vdb-units", "--vdb-color-space", "--supersample"})
         if (sub->count(o) > 0) throw Error(std::string(o) + ": applies to the VDB output; expected --vdb with it");
     if (!want_png)
       for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels"})
@@ -197,8 +206,12 @@ void add_slice(CLI::App& app, Common& common) {
     slice::SamplerOptions sampling;
     if (!slice::property_blend_from_name(opt->blend, sampling.blend))
       throw Error("--blend " + opt->blend + ": unknown; expected encoded or shepard");
-    const auto model = io::load_model(opt->model);
     job::VdbJobOptions vj;
+    if (!job::vdb_units_from_name(opt->vdb_units, vj.units))
+      throw Error("--vdb-units " + opt->vdb_units + ": unknown unit; expected mm or m");
+    if (!job::vdb_color_space_from_name(opt->vdb_color_space, vj.color_space))
+      throw Error("--vdb-color-space " + opt->vdb_color_space + ": unknown colour space; expected linear or srgb");
+    const auto model = io::load_model(opt->model);
     vj.sampler = sampling;
     std::optional<job::VdbPlan> plan;
     if (want_vdb) {
@@ -230,6 +243,10 @@ void add_slice(CLI::App& app, Common& common) {
     if (plan) {
       vdb_options["vdb.voxel_mm"] = job::option_number(plan->voxel_mm);
       vdb_options["vdb.supersample"] = std::to_string(plan->supersample);
+      // Like blend: only when not the default, so earlier manifests still resume.
+      if (vj.units != job::VdbUnits::mm) vdb_options["vdb.units"] = job::vdb_units_name(vj.units);
+      if (vj.color_space != job::VdbColorSpace::linear)
+        vdb_options["vdb.color_space"] = job::vdb_color_space_name(vj.color_space);
     }
     const std::string model_sha = io::sha256_file(opt->model);
     vj.model_sha256 = model_sha;  // the VDB's metadata: hashed once

@@ -16,6 +16,7 @@
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/sha256.hpp"
+#include "trivox/io/vdb_color.hpp"
 #include "trivox/io/vdb_volume.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/slice/material.hpp"
@@ -70,17 +71,31 @@ void prepare_folder(const fs::path& dir, bool require_empty, bool force) {
   fs::remove(probe, ec);
 }
 
+/// World units (the transform's) per model millimetre divisor: mm 1, m 1000.
+double unit_mm(VdbUnits u) { return u == VdbUnits::m ? 1000.0 : 1.0; }
+
+/// Grid names that Blender or Houdini read with a meaning of their own (Blender's volume
+/// attributes density, color, temperature, flame, heat; Houdini's density, Cd, temperature,
+/// heat, flame): a model property never takes one of them (docs/vdb.md, "Names").
+bool reserved_name(const std::string& n) {
+  for (const char* r : {"density", "color", "Cd", "temperature", "heat", "flame"})
+    if (n == r) return true;
+  return false;
+}
+
 /// What the grids are made of: names, and which properties feed which grid.
 struct Layout {
   int nprops = 0, nmat = 0;
   bool rgb = false;
+  bool linear = false;                      // color holds linear RGB (VdbColorSpace::linear)
+  int ncolor = 0;                           // 3 when the r, g, b sums are decoded per sample, else 0
   std::array<int, 3> rgb_props{};           // indices of r, g, b
   std::vector<int> extra_props;             // properties with a grid of their own
   std::vector<std::string> extra_names;     // their grid names
-  std::vector<std::array<float, 3>> material_rgb;  // palette RGB / 255
+  std::vector<std::array<float, 3>> material_rgb;  // palette RGB / 255, decoded to linear when linear
 };
 
-Layout make_layout(const vmodel::VModel& model, const slice::Palette& palette) {
+Layout make_layout(const vmodel::VModel& model, const slice::Palette& palette, VdbColorSpace space) {
   Layout l;
   l.nprops = static_cast<int>(model.properties.size());
   l.nmat = static_cast<int>(palette.materials.size());
@@ -97,34 +112,47 @@ Layout make_layout(const vmodel::VModel& model, const slice::Palette& palette) {
     const std::string& n = model.properties[static_cast<std::size_t>(p)];
     if (l.rgb && (p == found[0] || p == found[1] || p == found[2])) continue;
     if (palette.find(n) >= 0) continue;
-    const bool taken = n == "density" || n == "color" || n == "Cd" || n.rfind("material.", 0) == 0 ||
-                       n.rfind("property.", 0) == 0;
+    const bool taken = reserved_name(n) || n.rfind("material.", 0) == 0 || n.rfind("property.", 0) == 0;
     l.extra_props.push_back(p);
     l.extra_names.push_back(taken ? "property." + n : n);
   }
-  for (const auto& m : palette.materials)
-    l.material_rgb.push_back({m.rgba[0] / 255.0f, m.rgba[1] / 255.0f, m.rgba[2] / 255.0f});
+  l.linear = space == VdbColorSpace::linear;
+  l.ncolor = l.rgb && l.linear ? 3 : 0;
+  for (const auto& m : palette.materials) {
+    if (l.linear) {  // decoded first, so that mixing by fractions mixes light
+      std::array<float, 3> c{};
+      for (std::size_t q = 0; q < 3; ++q) c[q] = static_cast<float>(io::srgb_to_linear(m.rgba[q] / 255.0));
+      l.material_rgb.push_back(c);
+    } else {
+      l.material_rgb.push_back({m.rgba[0] / 255.0f, m.rgba[1] / 255.0f, m.rgba[2] / 255.0f});
+    }
+  }
   return l;
 }
 
 /// The VDB file's grids and metadata (docs/vdb.md): voxel (i, j, k) centred at origin + (ijk + 1/2)
 /// voxel; one float grid per palette material, then one per other property.
+/// World coordinates are millimetres, or metres (every length divided by 1000).
 io::VdbVolumeSpec volume_spec(const vmodel::VModel& model, const VdbPlan& plan, const slice::Palette& palette,
-                              const Layout& layout, const fs::path& model_file, const std::string& model_sha) {
-  const double vx = plan.voxel_mm;
+                              const Layout& layout, const VdbJobOptions& opt, const std::string& model_sha) {
+  const double vx = plan.voxel_mm, unit = unit_mm(opt.units);
+  const fs::path& model_file = opt.model_file;
   io::VdbVolumeSpec spec;
-  spec.voxel_size = vx;
-  spec.first_centre = {plan.origin[0] + vx / 2, plan.origin[1] + vx / 2, plan.origin[2] + vx / 2};
+  // mm: as before, with no division (the same bytes as files written before the option).
+  spec.voxel_size = opt.units == VdbUnits::mm ? vx : vx / unit;
+  for (std::size_t d = 0; d < 3; ++d)
+    spec.first_centre[d] = opt.units == VdbUnits::mm ? plan.origin[d] + vx / 2 : (plan.origin[d] + vx / 2) / unit;
   spec.metadata = {
-      {"units", std::string("mm")},
+      {"units", std::string(vdb_units_name(opt.units))},
       {"generator", std::string("trivox ") + trivox::version},
       {"source", model_file.filename().string()},
       {"source_sha256", model_sha},
-      {"voxel_size", vx},
+      {"voxel_size", spec.voxel_size},
       {"supersample", std::int32_t{plan.supersample}},
       {"palette", palette.name},
       {"palette_sha256", io::sha256_hex(slice::palette_json(palette))},
       {"colour_source", std::string(layout.rgb ? "r,g,b" : "palette")},
+      {"color_space", std::string(vdb_color_space_name(opt.color_space))},
   };
   for (const auto& mat : palette.materials)
     spec.float_grids.push_back({"material." + mat.name,
@@ -157,6 +185,26 @@ struct Scratch {
 };
 
 }  // namespace
+
+bool vdb_units_from_name(std::string_view name, VdbUnits& out) noexcept {
+  if (name == "mm") out = VdbUnits::mm;
+  else if (name == "m") out = VdbUnits::m;
+  else return false;
+  return true;
+}
+
+const char* vdb_units_name(VdbUnits units) noexcept { return units == VdbUnits::m ? "m" : "mm"; }
+
+bool vdb_color_space_from_name(std::string_view name, VdbColorSpace& out) noexcept {
+  if (name == "linear") out = VdbColorSpace::linear;
+  else if (name == "srgb") out = VdbColorSpace::srgb;
+  else return false;
+  return true;
+}
+
+const char* vdb_color_space_name(VdbColorSpace space) noexcept {
+  return space == VdbColorSpace::srgb ? "srgb" : "linear";
+}
 
 VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
   if (model.cells.empty())
@@ -234,12 +282,12 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const VdbPlan plan = plan_vdb_job(model, opt);
   const slice::Palette palette = opt.palette ? slice::load_palette(*opt.palette) : slice::default_palette();
   const slice::MaterialMapper mapper(palette, model.properties, opt.palette ? opt.palette->string() : std::string());
-  const Layout layout = make_layout(model, palette);
+  const Layout layout = make_layout(model, palette, opt.color_space);
   const std::string model_sha =
       !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : io::sha256_file(opt.model_file);
   prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
   // The grids, filled with the tasks' leaves in task order.
-  io::VdbVolume volume(volume_spec(model, plan, palette, layout, opt.model_file, model_sha));
+  io::VdbVolume volume(volume_spec(model, plan, palette, layout, opt, model_sha));
 
   const int N = plan.supersample;
   const int nx = plan.count[0], ny = plan.count[1], nz = plan.count[2];
@@ -266,7 +314,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const int slab1 = opt.layer_range ? ((*opt.layer_range)[1] + leaf_dim - 1) / leaf_dim : (nz + leaf_dim - 1) / leaf_dim;
   const int tasks = bands * (slab1 - slab0);
   const int P = layout.nprops, M = layout.nmat;
-  const int channels = P + M;
+  const int C = layout.ncolor;  // decoded r, g, b after the fractions (linear colour from r, g, b)
+  const int channels = P + M + C;
   const float inv_n3 = 1.0f / static_cast<float>(n3);
 
   tbb::enumerable_thread_specific<Scratch> scratch;
@@ -310,6 +359,10 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
             for (int h = 0; h < P; ++h) acc[h] = (first ? 0.0 : acc[h]) + p[h];
             mapper.fractions(p, s.fractions.data());
             for (int m = 0; m < M; ++m) acc[P + m] = (first ? 0.0 : acc[P + m]) + s.fractions[static_cast<std::size_t>(m)];
+            // Linear colour from r, g, b: each sample decoded, then averaged (mixing light).
+            for (int q = 0; q < C; ++q)
+              acc[P + M + q] = (first ? 0.0 : acc[P + M + q]) +
+                               io::srgb_to_linear(std::clamp(p[layout.rgb_props[static_cast<std::size_t>(q)]], 0.0f, 1.0f));
           }
         }
       }
@@ -356,7 +409,10 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               if (c < n3) ++out.fractional;
               out.density_sum += density;
               std::array<float, 3> rgb{0.0f, 0.0f, 0.0f};
-              if (layout.rgb) {
+              if (C > 0) {
+                for (int q = 0; q < 3; ++q)
+                  rgb[static_cast<std::size_t>(q)] = std::clamp(mean[static_cast<std::size_t>(P + M + q)], 0.0f, 1.0f);
+              } else if (layout.rgb) {
                 for (int q = 0; q < 3; ++q)
                   rgb[static_cast<std::size_t>(q)] =
                       std::clamp(mean[static_cast<std::size_t>(layout.rgb_props[static_cast<std::size_t>(q)])], 0.0f, 1.0f);
@@ -425,6 +481,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   sum.materials.reserve(static_cast<std::size_t>(M));
   for (const auto& m : palette.materials) sum.materials.push_back(m.name);
   sum.colour_source = layout.rgb ? "r,g,b" : "palette";
+  sum.units = vdb_units_name(opt.units);
+  sum.color_space = vdb_color_space_name(opt.color_space);
   sum.palette = palette.name;
   sum.sha256 = digest;
   sum.bytes = bytes;

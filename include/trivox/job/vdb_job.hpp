@@ -8,16 +8,21 @@
 ///   a voxel is active exactly when its density is above 0.
 /// - `color`: Vec3SGrid, 0..1: the model's `r`, `g`, `b` when it has all three (clamped to
 ///   0..1), otherwise the mix of the palette materials' RGB / 255 weighted by their fractions;
-///   `Cd`: a copy of it (Houdini's name for colour).
+///   `Cd`: a copy of it (Houdini's name for colour). VdbColorSpace::linear (the default): each
+///   sRGB colour (a sub-sample's r, g, b; a palette colour) is decoded to linear
+///   (io::srgb_to_linear) before the mean and the mix; srgb: the encoded values mixed as they are.
 /// - `material.<name>`: one FloatGrid per palette material: its fraction before dithering
 ///   (slice::MaterialMapper), summing to 1 over the materials in every active voxel.
 /// - one FloatGrid per other model property (not r, g, b and not a palette material's name),
-///   named like the property (`property.<name>` when that name is taken by a grid above).
+///   named like the property, or `property.<name>` when the name is taken by a grid above or is
+///   one that Blender or Houdini read with a meaning (density, color, Cd, temperature, heat,
+///   flame).
 /// Colour, fractions and properties are means over the inside sub-samples. Every grid has the
 /// active topology of `density`.
 ///
 /// Voxel (i, j, k) is index coordinate (i, j, k) and has its centre at origin + (i + 1/2,
-/// j + 1/2, k + 1/2) * voxel (world units: model mm), origin being the minimum corner of the
+/// j + 1/2, k + 1/2) * voxel (world units: model mm; with VdbUnits::m every length of the
+/// transform and the metadata divided by 1000), origin being the minimum corner of the
 /// model's bounding box (slice::model_bounds), like the slice grid (slice/grid.hpp).
 ///
 /// How: the model is sampled by slice::LayerSampler on a fine grid of pitch voxel / N (its voxel
@@ -42,12 +47,31 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "trivox/slice/sampler.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
 namespace trivox::job {
+
+/// The world unit of the grids' transform (`--vdb-units`): the model's millimetres, or metres
+/// (scale and translation divided by 1000: what Blender and Houdini take the transform as).
+enum class VdbUnits { mm, m };
+
+/// What the `color` and `Cd` grids hold (`--vdb-color-space`): linear RGB (the palette's and
+/// the model's sRGB colours decoded by io::srgb_to_linear, then mixed), or the sRGB-encoded
+/// values mixed as they are.
+enum class VdbColorSpace { linear, srgb };
+
+/// "mm" or "m" to VdbUnits; false for any other name (out unchanged).
+bool vdb_units_from_name(std::string_view name, VdbUnits& out) noexcept;
+/// "mm" or "m".
+const char* vdb_units_name(VdbUnits units) noexcept;
+/// "linear" or "srgb" to VdbColorSpace; false for any other name (out unchanged).
+bool vdb_color_space_from_name(std::string_view name, VdbColorSpace& out) noexcept;
+/// "linear" or "srgb".
+const char* vdb_color_space_name(VdbColorSpace space) noexcept;
 
 /// Options of the VDB output (`trivox slice --vdb`).
 struct VdbJobOptions {
@@ -57,6 +81,8 @@ struct VdbJobOptions {
   std::optional<std::filesystem::path> palette;  ///< palette file; the default palette when empty
   std::optional<double> voxel_mm;     ///< voxel edge in mm; automatic when empty (see plan_vdb_job)
   int supersample = 1;                ///< N: N^3 sub-samples per voxel, 1..8
+  VdbUnits units = VdbUnits::mm;      ///< the transform's world unit (the file's `units` metadata)
+  VdbColorSpace color_space = VdbColorSpace::linear;  ///< what color/Cd hold (`color_space` metadata)
   bool force = false;                 ///< write into a non-empty folder; allow dense boxes beyond the limit
   bool require_empty_folder = true;   ///< false when the PNG stack was just written into out_dir
   std::int64_t max_dense_voxels = 2'000'000'000;      ///< refuse larger boxes unless force
@@ -105,6 +131,8 @@ struct VdbJobSummary {
   std::vector<std::string> materials;     ///< palette names
   std::vector<double> material_volume_mm3;  ///< sum of fraction x density x voxel volume
   std::string colour_source;              ///< "r,g,b" or "palette"
+  std::string units;                      ///< the file's world unit: "mm" or "m"
+  std::string color_space;                ///< what color/Cd hold: "linear" or "srgb"
   std::string palette;                    ///< palette name
   std::string sha256;                     ///< of the written file
   std::int64_t bytes = 0;                 ///< file size
