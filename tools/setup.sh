@@ -7,13 +7,14 @@ set -euo pipefail
 # ConfigFile.xml), libzip (.gcvf), OpenSSL (SHA-256), OpenVDB (with Boost iostreams),
 # OpenImageIO (the PNG module; its CMake package wants OpenCV's headers and its own tools).
 # Tests: Catch2, OpenVDB's tools (vdb_print, vdb_render) and the Python modules of OpenVDB and
-# OpenImageIO as independent readers, unzip for the .gcvf archives.
+# OpenImageIO as independent readers, unzip for the .gcvf archives, Blender (run headless) as a
+# real client of the VDB volumes.
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libpugixml-dev libzip-dev libssl-dev
   libopenvdb-dev libboost-iostreams-dev
   libopenimageio-dev libopencv-core-dev openimageio-tools
-  catch2 libopenvdb-tools python3-openvdb python3-openimageio unzip
+  catch2 libopenvdb-tools python3-openvdb python3-openimageio unzip blender
 )
 
 missing=()
