@@ -211,6 +211,8 @@ VdbReport inspect_vdb(const fs::path& path) {
   if (l.meta) {
     r.metadata = metadata_of(*l.meta, false);
     if (auto u = l.meta->getMetadata<openvdb::StringMetadata>("units")) r.units = u->value();
+    if (r.units == "mm") r.mm_per_unit = 1.0;
+    if (r.units == "m") r.mm_per_unit = 1000.0;
   }
   for (const auto& g : l.grids) r.grids.push_back(grid_info(*g));
   if (auto density = find_float(l.grids, "density")) {

@@ -10,6 +10,9 @@
 #   centres (-1 + 0.3 i + 0.15 (s + 1/2)) in the solid: counted here exactly.
 # - Colours equal `trivox locate` at voxel centres within the sampler's 1/512; fractions follow
 #   the subtractive conversion of materials.md (C = m - r, ..., K = 1 - m, W = r + g + b - 2m).
+#   `color` holds them decoded to linear by IEC 61966-2-1 (c <= 0.04045: c / 12.92, else
+#   ((c + 0.055) / 1.055)^2.4, computed here), or as they are with --vdb-color-space srgb.
+# - --vdb-units m divides every length by 1000 and changes no value; shards merge to the same bytes.
 # - A box with linear properties: property grids equal the linear function at voxel centres.
 set -euo pipefail
 source "$(dirname "$0")/lib.bash" "$@"
@@ -218,13 +221,30 @@ vdb = [f for f in m["files"] if f["role"] == "vdb"]
 assert m["complete"] and len(vdb) == 1 and vdb[0]["file"] == "graded_block.vdb", m["files"]
 assert vdb[0]["sha256"] == hashlib.sha256(open(os.path.join(d, "graded_block.vdb"), "rb").read()).hexdigest()
 assert m["options"]["vdb"] == "yes" and m["options"]["vdb.voxel_mm"] == "1.016" and m["options"]["vdb.supersample"] == "1", m["options"]
+assert "vdb.units" not in m["options"] and "vdb.color_space" not in m["options"], m["options"]   # defaults
 PY
-"$py" - "$tmp/g1/graded_block.vdb" "$tmp/g1.json" "$trivox" models/graded_block.json <<'PY'
+"$trivox" slice models/graded_block.json -o "$tmp/g4" --vdb --vdb-voxel 1.016 --vdb-color-space srgb $q > /dev/null
+"$py" - "$tmp/g4/graded_block.vdb" "$tmp/g1.json" "$trivox" models/graded_block.json "$tmp/g1/graded_block.vdb" <<'PY'
 import sys, json, subprocess
 import pyopenvdb as vdb
-path, summary, trivox, model = sys.argv[1], json.load(open(sys.argv[2])), sys.argv[3], sys.argv[4]
+path, summary, trivox, model, linear_path = sys.argv[1], json.load(open(sys.argv[2])), sys.argv[3], sys.argv[4], sys.argv[5]
 grids, meta = vdb.readAll(path)
 g = {x.name: x for x in grids}
+lgrids, lmeta = vdb.readAll(linear_path)
+lg = {x.name: x for x in lgrids}
+decode = lambda c: c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+assert meta["color_space"] == "srgb" and lmeta["color_space"] == "linear" and g["Cd"].metadata["color_space"] == "srgb"
+assert {k: v for k, v in meta.items() if k != "color_space"} == {k: v for k, v in lmeta.items() if k != "color_space"}
+# The two files differ in color and Cd only, by the decode.
+values = lambda grid: {tuple(it["min"]): it["value"] for it in grid.citerOnValues()}
+for name in g:
+    a, b = values(g[name]), values(lg[name])
+    assert set(a) == set(b), name
+    if name in ("color", "Cd"):
+        assert all(abs(decode(x) - y) < 1e-6 for c in a for x, y in zip(a[c], b[c])), name
+    else:
+        assert a == b, name
+lcolor = values(lg["color"])
 dens = {tuple(it["min"]): it["value"] for it in g["density"].citerOnValues()}
 # Same grid as the 1.016 mm PNG stack (origin and pitch): the same voxels are filled.
 assert len(dens) == summary["filled"] == summary["vdb"]["active_voxels"], (len(dens), summary["filled"])
@@ -248,6 +268,8 @@ for c in keys[:: len(keys) // 7]:
     assert out["inside"], (c, out)
     rgb = [out["properties"][k] for k in "rgb"]
     assert all(abs(a - min(max(b, 0), 1)) < 1 / 512 + 1e-6 for a, b in zip(color[c], rgb)), (c, color[c], rgb)
+    # Linear: the decode's slope is at most 2.3, so the sampler's 1/512 grows to 2.3 / 512.
+    assert all(abs(a - decode(min(max(b, 0), 1))) < 2.3 / 512 + 1e-6 for a, b in zip(lcolor[c], rgb)), (c, lcolor[c], rgb)
     # Subtractive conversion (materials.md) of the voxel's colour.
     r, gg, b = color[c]
     mx = max(r, gg, b)
@@ -267,9 +289,10 @@ pts = []
 for z in (0, 4):
     for y in (0, 4):
         for x in (0, 4):
-            # r g b (grey 0.5), stiffness 100 + 10 x, UltraClear z / 16 (a palette material), density 7
-            pts.append([x, y, z, 0.5, 0.5, 0.5, 100 + 10 * x, z / 16, 7])
-m = {"trivox": 1, "units": "mm", "properties": ["r", "g", "b", "stiffness", "UltraClear", "density"],
+            # r g b (grey 0.5), stiffness 100 + 10 x, UltraClear z / 16 (a palette material), density 7,
+            # temperature 300 + y (density and temperature: names Blender and Houdini give a meaning)
+            pts.append([x, y, z, 0.5, 0.5, 0.5, 100 + 10 * x, z / 16, 7, 300 + y])
+m = {"trivox": 1, "units": "mm", "properties": ["r", "g", "b", "stiffness", "UltraClear", "density", "temperature"],
      "cells": [{"name": "box", "trivariate": {"orders": [2, 2, 2], "knots": [[0, 0, 1, 1]] * 3, "points": pts}}]}
 json.dump(m, open(sys.argv[1], "w"))
 PY
@@ -279,24 +302,77 @@ import sys
 import pyopenvdb as vdb
 grids, meta = vdb.readAll(sys.argv[1])
 g = {x.name: x for x in grids}
-assert len(grids) == 11 and {"stiffness", "property.density"} <= set(g), sorted(g)
+assert len(grids) == 12 and {"stiffness", "property.density", "property.temperature"} <= set(g), sorted(g)
+assert "temperature" not in g, sorted(g)
 assert g["property.density"].metadata["property"] == "density"
+assert g["property.temperature"].metadata["property"] == "temperature"
+grey = ((0.5 + 0.055) / 1.055) ** 2.4            # 0.5 decoded (IEC 61966-2-1): 0.2140...
 t = g["density"].transform
 def vals(name):
     return {tuple(it["min"]): it["value"] for it in g[name].citerOnValues()}
 dens = vals("density")
 assert len(dens) == 512
-for name in ("stiffness", "property.density", "material.UltraClear", "material.VeroBlack", "material.VeroUltraWhite"):
+for name in ("stiffness", "property.density", "property.temperature", "material.UltraClear", "material.VeroBlack",
+             "material.VeroUltraWhite"):
     assert set(vals(name)) == set(dens), name
 for c, s in vals("stiffness").items():
     x, y, z = t.indexToWorld(c)
     assert abs(s - (100 + 10 * x)) < 1e-4, (c, s)
     assert abs(g["property.density"].getConstAccessor().getValue(c) - 7) < 1e-5
+    assert abs(g["property.temperature"].getConstAccessor().getValue(c) - (300 + y)) < 1e-4
     clear = z / 16
     assert abs(g["material.UltraClear"].getConstAccessor().getValue(c) - clear) < 1e-5
     assert abs(g["material.VeroBlack"].getConstAccessor().getValue(c) - (1 - clear) / 2) < 1e-5
-    assert all(abs(a - 0.5) < 1e-6 for a in g["color"].getConstAccessor().getValue(c))
+    assert all(abs(a - grey) < 1e-6 for a in g["color"].getConstAccessor().getValue(c))
 PY
+
+# --- Units: metres (Blender, Houdini) -----------------------------------------------------------
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/fm" --vdb --vdb-voxel 0.25 --vdb-units m $q --json > "$tmp/fm.json"
+"$py" - "$tmp/fm/fichera.vdb" "$tmp/f1/fichera.vdb" "$tmp/fm/manifest.json" <<'PY'
+import sys, json
+import pyopenvdb as vdb
+m_grids, m_meta = vdb.readAll(sys.argv[1])
+mm_grids, mm_meta = vdb.readAll(sys.argv[2])
+assert m_meta["units"] == "m" and m_meta["voxel_size"] == 0.25 / 1000, m_meta
+assert {k: v for k, v in m_meta.items() if k not in ("units", "voxel_size")} == \
+       {k: v for k, v in mm_meta.items() if k not in ("units", "voxel_size")}
+mm = {g.name: g for g in mm_grids}
+for g in m_grids:
+    assert g.metadata["units"] == "m", g.name
+    t = g.transform
+    assert all(abs(a - 0.25e-3) < 1e-18 for a in t.voxelSize()), t.voxelSize()
+    assert all(abs(a + 0.875e-3) < 1e-15 for a in t.indexToWorld((0, 0, 0))), t.indexToWorld((0, 0, 0))
+    assert all(abs(a - 0.875e-3) < 1e-15 for a in t.indexToWorld((7, 7, 7))), t.indexToWorld((7, 7, 7))
+    values = lambda grid: {tuple(it["min"]): it["value"] for it in grid.citerOnValues()}
+    assert values(g) == values(mm[g.name]), g.name           # the same voxels and values
+assert json.load(open(sys.argv[3]))["options"]["vdb.units"] == "m"
+PY
+# inspect reports the world in the file's unit: the Fichera corner [-1, 1]^3 mm is [-0.001, 0.001]^3 m.
+"$trivox" inspect "$tmp/fm/fichera.vdb" > "$tmp/fm-inspect.txt"
+grep -q "^volume: 7e-09 m^3" "$tmp/fm-inspect.txt" || { cat "$tmp/fm-inspect.txt"; exit 1; }
+"$trivox" inspect "$tmp/fm/fichera.vdb" --json > "$tmp/fm-inspect.json"
+"$py" - "$tmp/fm-inspect.json" <<'PY'
+import sys, json
+r = json.load(open(sys.argv[1]))
+assert r["units"] == "m" and r["metadata"]["units"] == "m", r["units"]
+d = r["grids"][0]
+assert all(abs(a - b) < 1e-15 for a, b in zip(sum(d["world_bounds"], []), [-1e-3] * 3 + [1e-3] * 3)), d["world_bounds"]
+assert all(abs(a - 0.25e-3) < 1e-18 for a in d["voxel_size"]) and d["active_voxels"] == 448
+PY
+# render draws the same picture whatever the unit (the view is fitted to the volume).
+"$trivox" render "$tmp/fm/fichera.vdb" -o "$tmp/fm.png" --size 64,64 --json > "$tmp/fm-render.json"
+"$trivox" render "$tmp/f1/fichera.vdb" -o "$tmp/f1.png" --size 64,64 --json > "$tmp/f1-render.json"
+"$py" -c "
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+assert a['covered_pixels'] == b['covered_pixels'] > 1000, (a, b)
+" "$tmp/fm-render.json" "$tmp/f1-render.json"
+# Shards in metres merge to the file of the whole job.
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/fs" --vdb --vdb-voxel 0.125 --vdb-units m --shard 0/2 $q > /dev/null
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/fs" --vdb --vdb-voxel 0.125 --vdb-units m --shard 1/2 $q > /dev/null
+"$trivox" merge "$tmp/fs" > /dev/null
+"$trivox" slice models/gismo/fichera.xml -o "$tmp/fw" --vdb --vdb-voxel 0.125 --vdb-units m $q > /dev/null
+cmp "$tmp/fs/fichera.vdb" "$tmp/fw/fichera.vdb"
 
 # --- render: a picture of the volume ----------------------------------------------------------
 "$trivox" render "$tmp/g1/graded_block.vdb" -o "$tmp/top.png" --view +z --size 80,60 > /dev/null
@@ -339,6 +415,14 @@ expect_fail "a larger --vdb-voxel, or --force" "$trivox" slice models/gismo/fich
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --supersample 0
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --supersample 9
 expect_fail "expected --vdb with it" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --supersample 2
+expect_fail "^trivox: error: --vdb-units: applies to the VDB output; expected --vdb with it" \
+  "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb-units m
+expect_fail "^trivox: error: --vdb-color-space: applies to the VDB output" \
+  "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb-color-space srgb
+expect_fail "^trivox: error: --vdb-units cm: unknown unit; expected mm or m" \
+  "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-units cm
+expect_fail "^trivox: error: --vdb-color-space rgb: unknown colour space; expected linear or srgb" \
+  "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-color-space rgb
 expect_fail "expected --png with it" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --zip
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --png --vdb --supersample 9 --dpi 100,100
 [ ! -e "$tmp/x1" ]                                        # nothing written, not even the PNG stack

@@ -38,7 +38,7 @@ struct VdbGridInfo {
   std::string name;
   std::string type;         ///< value type: "float", "double", "vec3s", "int32", "bool", ...
   std::string grid_class;   ///< "fog volume", "level set", "staggered" or "unknown"
-  std::array<double, 3> voxel_size{};  ///< world units per voxel along x, y, z
+  std::array<double, 3> voxel_size{};  ///< world units (VdbReport::units) per voxel along x, y, z
   std::int64_t active_voxels = 0;
   bool empty = true;                   ///< no active voxels: bounds, range and mean are unset
   std::array<std::array<int, 3>, 2> index_bounds{};      ///< min and max active voxel (inclusive)
@@ -61,7 +61,11 @@ struct VdbReport {
     double volume = 0.0;              ///< sum(fraction x density x voxel volume)
   };
   std::vector<MaterialVolume> materials;
-  std::string units;                  ///< the file's "units" metadata, or empty
+  std::string units;                  ///< the file's "units" metadata, or empty: the unit of
+                                      ///< world_bounds, voxel_size and volume (trivox: mm or m)
+  /// Millimetres per world unit when `units` names one trivox knows ("mm": 1, "m": 1000), so
+  /// that volume x mm_per_unit^3 is in mm^3; empty for other or no units.
+  std::optional<double> mm_per_unit;
 };
 
 /// Reads and summarises a .vdb file.
