@@ -51,7 +51,8 @@ nlohmann::ordered_json to_json(const io::StackReport& r, const std::string& path
             {"slices", c.slices},
             {"prefix", c.prefix},
             {"digits", c.digits},
-            {"background", c.background}}},
+            {"background", c.background},
+            {"max_colors", c.max_colors}}},
           {"voxel_size_mm", {25.4 / c.dpi_x, 25.4 / c.dpi_y, c.slice_thickness_nm * 1e-6}},
           {"voxel_volume_mm3", r.voxel_volume_mm3},
           {"size_mm", {c.width * 25.4 / c.dpi_x, c.height * 25.4 / c.dpi_y, c.slices * c.slice_thickness_nm * 1e-6}},
@@ -85,6 +86,8 @@ void print_human(const io::StackReport& r, const std::string& path) {
               fmt(c.width * 25.4 / c.dpi_x, 6).c_str(), fmt(c.height * 25.4 / c.dpi_y, 6).c_str(),
               fmt(c.slices * c.slice_thickness_nm * 1e-6, 6).c_str(), c.slice_name(0).c_str(),
               c.slice_name(c.slices - 1).c_str());
+  std::printf("void: %s (%s); MaxNumberOfColors %d\n", io::stack_background_name(c.background).c_str(),
+              (std::to_string(c.background[0]) + " " + std::to_string(c.background[1]) + " " + std::to_string(c.background[2]) + " " + std::to_string(c.background[3])).c_str(), c.max_colors);
   std::printf("present: %d of %d", r.present, c.slices);
   if (!r.missing.empty()) std::printf("; missing %zu: %s", r.missing.size(), list(r.missing).c_str());
   if (!r.corrupt.empty()) std::printf("; corrupt %zu: %s", r.corrupt.size(), list(r.corrupt).c_str());

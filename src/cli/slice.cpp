@@ -27,6 +27,8 @@ struct Options {
   double layer = 0.0;
   int threads = 0;
   bool zip = false, force = false;
+  int digits = 0;
+  std::string background = "transparent";
   double max_voxels = 1e11;  // a double, so that 1e9 reads as the help writes it
   bool png = false, vdb = false;
   double vdb_voxel = 0.0;
@@ -164,6 +166,10 @@ void add_slice(CLI::App& app, Common& common) {
   sub->add_option("--blend", opt->blend,
                   "Shepard fillet cells: encoded (their control points, default) or shepard (the exact blend per voxel)");
   sub->add_flag("--zip", opt->zip, "Also pack the folder as <DIR>.gcvf");
+  sub->add_option("--digits", opt->digits,
+                  "Zero-pad slice numbers to N digits (default 0: slice_0.png, as Voxel Print tools name them)");
+  sub->add_option("--background", opt->background,
+                  "Void pixels: transparent (0 0 0 0, default) or black (0 0 0 255); declared in ConfigFile.xml");
   sub->add_flag("--force", opt->force, "Write into a non-empty folder; allow jobs beyond the tray or --max-voxels");
   sub->add_option("--max-voxels", opt->max_voxels, "Refuse larger grids unless --force (default 1e11)");
   sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)");
@@ -186,7 +192,7 @@ void add_slice(CLI::App& app, Common& common) {
       for (const char* o : {"--vdb-voxel", "--vdb-units", "--vdb-color-space", "--supersample"})
         if (sub->count(o) > 0) throw Error(std::string(o) + ": applies to the VDB output; expected --vdb with it");
     if (!want_png)
-      for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels"})
+      for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels", "--digits", "--background"})
         if (sub->count(o) > 0)
           throw Error(std::string(o) + ": applies to the PNG stack; expected --png with it (--vdb alone writes only the VDB)");
     if (opt->progress != "auto" && opt->progress != "bar" && opt->progress != "lines" && opt->progress != "never")
@@ -316,6 +322,15 @@ void add_slice(CLI::App& app, Common& common) {
     job.dither = opt->dither;
     job.force = opt->force;
     job.zip = opt->zip;
+    job.digits = opt->digits;
+    job.background = opt->background;
+    // Resuming continues the job as it was named and painted: unless given again, the slice
+    // names and the void colour are the manifest's (an earlier trivox's padded names included).
+    if (opt->resume)
+      if (const auto m = job::read_manifest(opt->out, shard.manifest_name())) {
+        if (sub->count("--digits") == 0 && m->options.count("png.digits")) job.digits = std::stoi(m->options.at("png.digits"));
+        if (sub->count("--background") == 0 && m->options.count("png.background")) job.background = m->options.at("png.background");
+      }
     job.model_file = opt->model;
     job.model_sha256 = model_sha;
     job.extra_options = vdb_options;
@@ -346,6 +361,9 @@ void add_slice(CLI::App& app, Common& common) {
                                 {"printer", job.profile.name},
                                 {"dpi", {job.profile.dpi_x, job.profile.dpi_y}},
                                 {"layer_mm", job.profile.layer_mm},
+                                {"background", job.background},
+                                {"digits", job.digits},
+                                {"max_materials", job.profile.channels},
                                 {"grid", {{"origin", s.grid.origin}, {"pitch", s.grid.pitch}, {"count", s.grid.count}}},
                                 {"layers", s.grid.count[2]},
                                 {"voxels", s.voxels},
