@@ -36,7 +36,8 @@
 /// for any thread count, and a reader never sees a partial file.
 ///
 /// Cost: one sampler evaluation per sub-sample inside the model's leaf regions (N^3 per voxel;
-/// void far from the model costs nothing), plus O(properties + materials) per inside sub-sample.
+/// void far from the model costs nothing), plus O(properties + materials) per inside sub-sample
+/// (and 3 pow for the linear colour of a model with r, g, b).
 /// Memory: the finished grids (about 4 x (7 + materials + properties) bytes per active voxel,
 /// plus OpenVDB's node overhead), plus per worker one task's dense sums. Writing streams; the
 /// file is hashed twice (about 1 s per GB).
