@@ -85,8 +85,13 @@ bool write_all(int fd, std::string_view bytes) {
   if (!fs::is_directory(dir, ec))
     throw Error(path.string() + ": cannot write: folder " + dir.string() +
                 " does not exist; expected an existing, writable folder");
+  // A full disk or a failing device stops a valid job (exit 1); a path the user may not write
+  // to is the user's to change (exit 2).
+  const bool device = err == ENOSPC || err == EDQUOT || err == EIO || err == EFBIG;
   throw Error(path.string() + ": cannot write: " + system_reason(err) +
-              "; expected a writable path");
+                  (device ? "; expected room on the disk (the job can be resumed with --resume once there is)"
+                          : "; expected a writable path"),
+              device ? ErrorKind::failed : ErrorKind::bad_input);
 }
 
 /// Makes the rename itself durable; failure here loses nothing already written, so it is ignored.
