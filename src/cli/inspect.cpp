@@ -166,8 +166,11 @@ nlohmann::ordered_json vdb_json(const io::VdbReport& r) {
     j["metadata"] = meta_json(g.metadata);
     grids.push_back(std::move(j));
   }
+  // Volumes in mm^3 whatever the file's unit (a file in metres holds m^3); a file of unknown
+  // units is taken as millimetres, as trivox writes by default.
+  const double k = std::pow(r.mm_per_unit.value_or(1.0), 3);
   nlohmann::ordered_json materials = nlohmann::ordered_json::array();
-  for (const auto& m : r.materials) materials.push_back({{"name", m.name}, {"volume_mm3", m.volume}});
+  for (const auto& m : r.materials) materials.push_back({{"name", m.name}, {"volume_mm3", m.volume * k}});
   return {{"path", r.path},
           {"kind", "vdb"},
           {"bytes", r.bytes},
@@ -175,7 +178,7 @@ nlohmann::ordered_json vdb_json(const io::VdbReport& r) {
           {"units", r.units.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(r.units)},
           {"metadata", meta_json(r.metadata)},
           {"grids", grids},
-          {"volume_mm3", r.volume ? nlohmann::ordered_json(*r.volume) : nlohmann::ordered_json(nullptr)},
+          {"volume_mm3", r.volume ? nlohmann::ordered_json(*r.volume * k) : nlohmann::ordered_json(nullptr)},
           {"materials", materials}};
 }
 
@@ -221,7 +224,8 @@ void print_vdb(const io::VdbReport& r) {
                 g.grid_class.c_str(), voxel.c_str(), static_cast<long long>(g.active_voxels), values_text(g.min).c_str(),
                 values_text(g.max).c_str(), values_text(g.mean).c_str());
   }
-  std::printf("\n%-*s %-34s %s\n", wi, "active bounds", "index (voxels, inclusive)", "world (voxel boxes)");
+  const std::string world = "world (voxel boxes" + (r.units.empty() ? std::string() : ", " + r.units) + ")";
+  std::printf("\n%-*s %-34s %s\n", wi, "active bounds", "index (voxels, inclusive)", world.c_str());
   for (const auto& g : r.grids) {
     if (g.empty) {
       std::printf("%-*s %s\n", wi, g.name.c_str(), "(no active voxels)");

@@ -358,6 +358,9 @@ assert r["units"] == "m" and r["metadata"]["units"] == "m", r["units"]
 d = r["grids"][0]
 assert all(abs(a - b) < 1e-15 for a, b in zip(sum(d["world_bounds"], []), [-1e-3] * 3 + [1e-3] * 3)), d["world_bounds"]
 assert all(abs(a - 0.25e-3) < 1e-18 for a in d["voxel_size"]) and d["active_voxels"] == 448
+# The JSON's volumes are in mm^3 whatever the file's unit: 448 voxels of 0.25 mm = 7 mm^3.
+assert abs(r["volume_mm3"] - 7) < 1e-9, r["volume_mm3"]
+assert abs(sum(m["volume_mm3"] for m in r["materials"]) - 7) < 1e-6, r["materials"]
 PY
 # render draws the same picture whatever the unit (the view is fitted to the volume).
 "$trivox" render "$tmp/fm/fichera.vdb" -o "$tmp/fm.png" --size 64,64 --json > "$tmp/fm-render.json"
