@@ -17,7 +17,6 @@
 // function space on [0, 1].
 #include <catch2/catch.hpp>
 
-#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -134,13 +133,6 @@ double check_generic(const Surface& f1, const Surface& f2, const fillet::RailPai
   return worst;
 }
 
-template <class F>
-double seconds(F&& f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 }  // namespace
 
 TEST_CASE("perpendicular planes: rails are the lines x = 2 + d1 and z = d2", "[rails]") {
@@ -223,9 +215,7 @@ TEST_CASE("a cylinder on a floor: circles of radius r + d1 and height d2", "[rai
   REQUIRE(curves.size() == 1);
   const std::array<double, 2> outward{1.0, outward_from(cyl, {0, 0, 0.5})};
   const std::array<double, 2> d{d1, d2};
-  fillet::RailPair rp;
-  const double secs = seconds([&] { rp = fillet::offset_rails(floor, cyl, outward, curves[0], d); });
-  CHECK(secs < 1.0);
+  const fillet::RailPair rp = fillet::offset_rails(floor, cyl, outward, curves[0], d);
   const double tol = 1e-7;
   check_generic(floor, cyl, rp, d, tol);
   for (int k = 0; k <= 500; ++k) {
@@ -258,9 +248,7 @@ TEST_CASE("a plane through a sphere: a closed loop and its rails", "[rails]") {
   const std::array<double, 2> outward{outward_from(plane, {0, 1, 0}), outward_from(sphere, {0, 0, 0})};
   const double d1 = 0.25, d2 = 0.3, tol = 1e-7;
   const std::array<double, 2> d{d1, d2};
-  fillet::RailPair rp;
-  const double secs = seconds([&] { rp = fillet::offset_rails(plane, sphere, outward, curves[0], d); });
-  CHECK(secs < 1.0);
+  const fillet::RailPair rp = fillet::offset_rails(plane, sphere, outward, curves[0], d);
   CHECK(rp.closed);
   check_generic(plane, sphere, rp, d, tol);
   const double rho = std::sqrt(0.75);
@@ -330,9 +318,7 @@ TEST_CASE("an offset beyond the radius of curvature is trimmed at its self-cross
   REQUIRE(curves.size() == 1);
   const double d1 = 0.8, d2 = 0.5, tol = 1e-7;
   const std::array<double, 2> d{d1, d2};
-  fillet::RailPair rp;
-  const double secs = seconds([&] { rp = fillet::offset_rails(floor, wall, {1, -1}, curves[0], d); });
-  CHECK(secs < 1.0);
+  const fillet::RailPair rp = fillet::offset_rails(floor, wall, {1, -1}, curves[0], d);
   check_generic(floor, wall, rp, d, tol);
   REQUIRE(rp.rails[0].trimmed.size() == 1);
   CHECK(rp.rails[1].trimmed.empty());
@@ -385,9 +371,7 @@ TEST_CASE("an ellipse offset inwards beyond its smallest radius: two trimmed swa
   const std::array<double, 2> d{d1, d2};
   fillet::RailOptions o;
   o.flip = {true, false};
-  fillet::RailPair rp;
-  const double secs = seconds([&] { rp = fillet::offset_rails(floor, wall, outward, curves[0], d, o); });
-  CHECK(secs < 1.0);
+  const fillet::RailPair rp = fillet::offset_rails(floor, wall, outward, curves[0], d, o);
   check_generic(floor, wall, rp, d, tol);
   REQUIRE(rp.rails[0].trimmed.size() == 2);
   CHECK(rp.rails[1].trimmed.empty());
