@@ -8,13 +8,15 @@ set -euo pipefail
 # OpenImageIO (the PNG module; its CMake package wants OpenCV's headers and its own tools).
 # Tests: Catch2, OpenVDB's tools (vdb_print, vdb_render) and the Python modules of OpenVDB and
 # OpenImageIO as independent readers, unzip for the .gcvf archives, Blender (run headless) as a
-# real client of the VDB volumes.
+# real client of the VDB volumes, Slurm and munge (a one-node cluster started by a test) and
+# PyYAML (the Kubernetes Job manifests of docs/jobs.md) for the schedulers users run trivox on.
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libpugixml-dev libzip-dev libssl-dev
   libopenvdb-dev libboost-iostreams-dev
   libopenimageio-dev libopencv-core-dev openimageio-tools
   catch2 libopenvdb-tools python3-openvdb python3-openimageio unzip blender
+  slurm-wlm munge python3-yaml
 )
 
 missing=()
