@@ -10,6 +10,8 @@ set -euo pipefail
 # OpenImageIO as independent readers, unzip for the .gcvf archives, Blender (run headless) as a
 # real client of the VDB volumes, Slurm and munge (a one-node cluster started by a test) and
 # PyYAML (the Kubernetes Job manifests of docs/jobs.md) for the schedulers users run trivox on.
+# Sanitizers and fuzzing (tools/sanitize.sh, tools/fuzz.sh): clang 14 and its runtimes (ASan,
+# UBSan, libFuzzer for -fsanitize=fuzzer), which clang only recommends.
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libpugixml-dev libzip-dev libssl-dev
@@ -17,6 +19,7 @@ packages=(
   libopenimageio-dev libopencv-core-dev openimageio-tools
   catch2 libopenvdb-tools python3-openvdb python3-openimageio unzip blender
   slurm-wlm munge python3-yaml
+  clang libclang-rt-14-dev
 )
 
 missing=()
