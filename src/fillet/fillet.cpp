@@ -187,7 +187,8 @@ void measure(const std::array<const Surface*, 2>& faces, const Surface& blend, c
   for (const auto& [r, range] : l.on_blend) {
     const Surface on = face_of(f, r);
     const auto du = on.domain(0), dv = on.domain(1);
-    grid(on, [&](double u, double v) {
+    // Captured by name: clang before version 16 cannot capture a structured binding.
+    grid(on, [&, &range = range](double u, double v) {
       on.eval({u, v}, p.data());
       const double a = (u - du[0]) / (du[1] - du[0]), b = (v - dv[0]) / (dv[1] - dv[0]);
       const double sv = bv[0] + (bv[1] - bv[0]) * (range[0] + b * (range[1] - range[0]));

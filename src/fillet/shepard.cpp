@@ -243,7 +243,8 @@ ShepardEncoding encode_shepard(const spline::Trivariate& half, const vmodel::She
   out.rms_error = std::sqrt(se / static_cast<double>(total * m));
   const auto mid = [](const std::vector<double>& t, int k) { return 0.5 * (t[static_cast<std::size_t>(k)] + t[static_cast<std::size_t>(k) + 1]); };
   std::vector<double> check(static_cast<std::size_t>(std::max(0, ns[0] - 1)), 0.0);
-  tbb::parallel_for(0, ns[0] - 1, [&](int a) {
+  // H captured by name: clang before version 16 cannot capture a structured binding.
+  tbb::parallel_for(0, ns[0] - 1, [&, &H = H](int a) {
     vmodel::ShepardWalk walk;
     std::vector<double> y(static_cast<std::size_t>(dim)), fv(static_cast<std::size_t>(m));
     double e = 0.0;
