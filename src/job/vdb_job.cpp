@@ -34,6 +34,10 @@ constexpr double max_axis = 1073741824.0;        // 2^30 sub-samples along an ax
 constexpr std::int64_t task_voxels = 1 << 18;    // voxels of one task (dense sums)
 constexpr std::int64_t task_samples = 1 << 22;   // sub-samples of one task
 constexpr int sample_rows = 32;                  // fine rows per sampler call (multiple of 4)
+/// The smallest voxel edge, in the file's unit, that OpenVDB takes: its scale maps refuse a
+/// transform whose determinant (edge^3) is under 3e-15 ("Non-zero scale values required",
+/// openvdb/math/Maps.h, ScaleMap), i.e. an edge under cbrt(3e-15) = 1.44e-5.
+const double min_scale = std::cbrt(3e-15) * (1 + 1e-12);
 
 std::string num(double v) {
   char buf[32];
@@ -247,6 +251,11 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
     plan.voxel_mm = round_up_2_digits(v);
   }
   const double vx = plan.voxel_mm;
+  if (vx / unit_mm(opt.units) < min_scale)
+    throw Error("--vdb-voxel " + num(vx) + ": a voxel of " + num(vx / unit_mm(opt.units)) + " " +
+                vdb_units_name(opt.units) + "; expected at least " + num(min_scale * unit_mm(opt.units)) +
+                " mm, the smallest voxel OpenVDB's transforms take in " + vdb_units_name(opt.units) +
+                (opt.units == VdbUnits::m ? " (or --vdb-units mm, which takes voxels down to 1.45e-05 mm)" : ""));
   double dense = 1.0;
   static constexpr const char* axis = "xyz";
   for (std::size_t d = 0; d < 3; ++d) {

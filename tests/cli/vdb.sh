@@ -415,6 +415,12 @@ PY
 expect_fail "expected a voxel edge in mm" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel 0
 expect_fail "expected a voxel edge in mm" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel -1
 expect_fail "a larger --vdb-voxel, or --force" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel 1e-4
+# Voxels OpenVDB's transforms refuse (an edge under cbrt(3e-15) = 1.44e-5 in the file's unit),
+# refused before a file or manifest is written, even with --force.
+expect_fail "expected at least 1.44225e-05 mm, the smallest voxel OpenVDB's transforms take in mm" \
+  "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel 1e-7 --force
+expect_fail "a voxel of 1e-05 m; expected at least 0.0144225 mm" \
+  "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel 0.01 --vdb-units m --force
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --supersample 0
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --supersample 9
 expect_fail "expected --vdb with it" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --supersample 2
