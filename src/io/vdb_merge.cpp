@@ -44,7 +44,8 @@ void merge_vdb_parts(const std::vector<fs::path>& parts, const fs::path& out) {
     try {
       std::ifstream in(parts[p], std::ios::binary);
       if (!in) throw Error(parts[p].string() + ": cannot open: " + std::strerror(errno) + "; expected a shard's VDB part");
-      openvdb::io::Stream stream(in);
+      // Read whole (no delayed loading), so nothing is copied to a temporary folder ($TMPDIR).
+      openvdb::io::Stream stream(in, /*delayLoad=*/false);
       grids = stream.getGrids();
       file_meta = stream.getMetadata();
     } catch (const openvdb::Exception& e) {
