@@ -9,12 +9,14 @@
 #include <tbb/parallel_for.h>
 
 #include "trivox/error.hpp"
+#include "trivox/limits.hpp"
 #include "trivox/spline/evaluator.hpp"
 
 namespace trivox::geom {
 
 GaussRule gauss_legendre(int n) {
-  if (n < 1 || n > 64) throw Error("Gauss rule of " + std::to_string(n) + " points; expected 1..64");
+  // Time O(n^2), memory O(n); callers bound n by the orders they accept (trivox/limits.hpp).
+  if (n < 1 || n > 4096) throw Error("Gauss rule of " + std::to_string(n) + " points; expected 1..4096");
   // Newton's method on the Legendre polynomial from Chebyshev-like starts (Numerical Recipes
   // gauleg); the three-term recurrence gives P_n and P_n'.
   GaussRule g{std::vector<double>(static_cast<std::size_t>(n)), std::vector<double>(static_cast<std::size_t>(n))};
@@ -53,6 +55,10 @@ namespace {
 template <class F>
 double integrate(const spline::Trivariate& s, int extra_points, F&& f) {
   if (s.dim() < 3) throw Error("integral over a trivariate in R^" + std::to_string(s.dim()) + "; expected xyz");
+  // Before any rule is built: the points per direction grow with the order, the work with its cube.
+  const Limits limits = default_limits();
+  for (int d = 0; d < 3; ++d)
+    check_order(s.knots(d).order(), limits, std::string("integral over a cell, direction ") + "uvw"[d]);
   std::array<GaussRule, 3> rules;
   std::array<std::vector<double>, 3> breaks;
   for (int d = 0; d < 3; ++d) {

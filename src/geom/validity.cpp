@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "trivox/error.hpp"
+#include "trivox/limits.hpp"
 #include "trivox/spline/calculus.hpp"
 #include "trivox/spline/refine.hpp"
 
@@ -232,11 +233,27 @@ const char* validity_name(Validity v) noexcept {
   }
 }
 
+namespace {
+
+/// The determinant spline has about 3 x the order per direction and its pieces (3 x order)^P
+/// coefficients: the orders are checked before any is built.
+template <int P>
+void check_orders(const spline::TensorSpline<P>& s) {
+  const Limits limits = default_limits();
+  for (int d = 0; d < P; ++d)
+    check_order(s.knots(d).order(), limits, std::string("validity of a ") + (P == 3 ? "cell" : "surface") +
+                                                ", direction " + "uvw"[d]);
+}
+
+}  // namespace
+
 ValidityReport<3> check_validity(const spline::Trivariate& cell, const ValidityOptions& options) {
+  check_orders(cell);
   return check<3>(cell, options, 3);
 }
 
 ValidityReport<2> check_validity(const spline::Surface& surface, const ValidityOptions& options) {
+  check_orders(surface);
   return check<2>(surface, options, 2);
 }
 

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
 #include "trivox/error.hpp"
+#include "trivox/limits.hpp"
 
 namespace trivox::spline {
 
@@ -42,8 +44,19 @@ KnotVector::KnotVector(int order, std::vector<double> knots) : order_(order), kn
                   " times from knot " + std::to_string(i) + "; expected multiplicity <= order");
   // Reciprocal knot differences per span for the divisions of Cox-de Boor (zero for empty spans,
   // which find_span never returns).
-  const int p = order_ - 1, tri = p * (p + 1) / 2;
-  inv_.assign(static_cast<std::size_t>((size() - p) * tri), 0.0);
+  const int p = order_ - 1;
+  const std::int64_t tri = std::int64_t{p} * (p + 1) / 2, entries = (size() - p) * tri;
+  // spans x order^2 / 2 doubles: bounded by the input limits before a byte is allocated. The
+  // lock of default_limits is taken only for tables beyond a million entries (8 MB), which no
+  // model of the repository comes near.
+  if (entries > (std::int64_t{1} << 20)) {
+    const std::int64_t most = default_limits().max_points;
+    if (entries > most)
+      throw Error("order " + std::to_string(order_) + " over " + std::to_string(size() - p) + " spans: " +
+                  std::to_string(entries) + " knot differences for Cox-de Boor (spans x order x (order - 1) / 2); expected at most " +
+                  std::to_string(most) + limit_hint("max_points"));
+  }
+  inv_.assign(static_cast<std::size_t>(entries), 0.0);
   for (int mu = p; mu < size(); ++mu) {
     if (!(knots_[static_cast<std::size_t>(mu)] < knots_[static_cast<std::size_t>(mu) + 1])) continue;
     double* iv = inv_.data() + (mu - p) * tri;
@@ -217,34 +230,39 @@ void KnotVector::basis_derivatives(int span, double t, int nder, double* out) co
   }
   const int requested = nder;
   nder = std::min(nder, p);
-  // Stack storage for the usual orders; the heap only for orders above 16.
+  // Only the values of degrees p - nder .. p are needed (columns of A2.3's triangle), and its
+  // lower half, the knot differences, is recomputed from left and right: O(order) memory where
+  // A2.3 takes O(order^2) (an order of 20000 took 1.6 GB per evaluation). Same operations in
+  // the same order, so the same bits. Stack storage for the usual orders.
   constexpr int stack_order = 16;
-  double ndu_stack[stack_order * stack_order], left_stack[stack_order], right_stack[stack_order];
+  double stack[(max_derivative_order + 4) * stack_order];
   std::vector<double> heap;
-  double* ndu = ndu_stack;
-  double* left = left_stack;
-  double* right = right_stack;
+  double* buffer = stack;
   if (o > stack_order) {
-    heap.resize(static_cast<std::size_t>(o * o + 2 * o));
-    ndu = heap.data();
-    left = ndu + o * o;
-    right = left + o;
+    heap.resize(static_cast<std::size_t>((nder + 4) * o));
+    buffer = heap.data();
   }
-  auto NDU = [&](int i, int j) -> double& { return ndu[i * o + j]; };
-  NDU(0, 0) = 1.0;
+  double* left = buffer;
+  double* right = left + o;
+  double* N = right + o;       // the values of degree j, updated in place
+  double* cols = N + o;        // cols[(j - (p - nder)) * o + r]: N_r of degree j >= p - nder
+  auto value = [&](int r, int j) { return cols[(j - (p - nder)) * o + r]; };
+  auto difference = [&](int j, int r) { return right[r + 1] + left[j - r]; };  // A2.3's ndu[j][r], r < j
+  N[0] = 1.0;
+  if (p - nder == 0) cols[0] = 1.0;
   for (int j = 1; j <= p; ++j) {
     left[j] = t - knots_[static_cast<std::size_t>(span + 1 - j)];
     right[j] = knots_[static_cast<std::size_t>(span + j)] - t;
     double saved = 0.0;
     for (int r = 0; r < j; ++r) {
-      NDU(j, r) = right[r + 1] + left[j - r];  // lower triangle: knot differences
-      const double tmp = NDU(r, j - 1) / NDU(j, r);
-      NDU(r, j) = saved + right[r + 1] * tmp;
+      const double tmp = N[r] / difference(j, r);
+      N[r] = saved + right[r + 1] * tmp;
       saved = left[j - r] * tmp;
     }
-    NDU(j, j) = saved;
+    N[j] = saved;
+    if (j >= p - nder) std::copy(N, N + j + 1, cols + (j - (p - nder)) * o);
   }
-  for (int j = 0; j <= p; ++j) out[j] = NDU(j, p);
+  for (int j = 0; j <= p; ++j) out[j] = value(j, p);
   double a[2][max_derivative_order + 1];
   for (int r = 0; r <= p; ++r) {
     int s1 = 0, s2 = 1;
@@ -254,18 +272,18 @@ void KnotVector::basis_derivatives(int span, double t, int nder, double* out) co
       double d = 0.0;
       const int rk = r - k, pk = p - k;
       if (r >= k) {
-        a[s2][0] = a[s1][0] / NDU(pk + 1, rk);
-        d = a[s2][0] * NDU(rk, pk);
+        a[s2][0] = a[s1][0] / difference(pk + 1, rk);
+        d = a[s2][0] * value(rk, pk);
       }
       const int j1 = (rk >= -1) ? 1 : -rk;
       const int j2 = (r - 1 <= pk) ? k - 1 : p - r;
       for (int j = j1; j <= j2; ++j) {
-        a[s2][j] = (a[s1][j] - a[s1][j - 1]) / NDU(pk + 1, rk + j);
-        d += a[s2][j] * NDU(rk + j, pk);
+        a[s2][j] = (a[s1][j] - a[s1][j - 1]) / difference(pk + 1, rk + j);
+        d += a[s2][j] * value(rk + j, pk);
       }
       if (r <= pk) {
-        a[s2][k] = -a[s1][k - 1] / NDU(pk + 1, r);
-        d += a[s2][k] * NDU(r, pk);
+        a[s2][k] = -a[s1][k - 1] / difference(pk + 1, r);
+        d += a[s2][k] * value(r, pk);
       }
       out[k * o + r] = d;
       std::swap(s1, s2);

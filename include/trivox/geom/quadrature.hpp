@@ -6,7 +6,9 @@
 /// element. For a polynomial cell of degrees (p_u, p_v, p_w) the Jacobian determinant has degree
 /// 3 p_d - 1 in direction d, so ceil(3 p_d / 2) points per direction integrate it exactly (the
 /// volume is exact up to rounding); rational cells use 3 p_d + 2 points (not exact: the
-/// determinant is rational). Cost: O(elements * prod(points) * evaluation).
+/// determinant is rational). Cost: O(elements * prod(points) * evaluation). The integrals first
+/// check every order against the process's default limits (trivox/limits.hpp, max_order) and
+/// throw trivox::Error (bad_input) for a cell above it, before building a rule.
 #pragma once
 #include <vector>
 
@@ -18,7 +20,8 @@ namespace trivox::geom {
 struct GaussRule {
   std::vector<double> nodes, weights;
 };
-/// @param n  number of points, 1..64
+/// @param n  number of points, 1..4096 (time O(n^2), memory O(n))
+/// @throws trivox::Error (bad_input) for n outside 1..4096
 GaussRule gauss_legendre(int n);
 
 /// The signed volume: the integral of det[dX/du, dX/dv, dX/dw] over the parametric domain

@@ -67,11 +67,13 @@ struct ValidityOptions {
 };
 
 /// The validity of a polynomial trivariate's xyz parametrisation (coordinates 0..2).
-/// @throws trivox::Error (bad_input) for a rational cell or fewer than 3 coordinates
+/// @throws trivox::Error (bad_input) for a rational cell, fewer than 3 coordinates, or an order
+///         above the process's default max_order (trivox/limits.hpp), checked first
 ValidityReport<3> check_validity(const spline::Trivariate& cell, const ValidityOptions& options = {});
 
 /// The same for a planar surface (coordinates 0..1: x and y).
-/// @throws trivox::Error (bad_input) for a rational surface or fewer than 2 coordinates
+/// @throws trivox::Error (bad_input) for a rational surface, fewer than 2 coordinates, or an
+///         order above the process's default max_order
 ValidityReport<2> check_validity(const spline::Surface& surface, const ValidityOptions& options = {});
 
 }  // namespace trivox::geom

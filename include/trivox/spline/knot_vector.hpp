@@ -30,7 +30,10 @@ public:
   /// @param order  degree + 1, at least 1
   /// @param knots  n + order finite non-decreasing values, n >= order, non-empty domain,
   ///               no interior knot repeated more than `order` times
-  /// @throws trivox::Error (bad_input) naming the first offending entry and what was expected
+  /// @throws trivox::Error (bad_input) naming the first offending entry and what was expected,
+  ///         or when its table of knot differences (spans x order x (order - 1) / 2 doubles,
+  ///         built here) would exceed the process's default max_points (trivox/limits.hpp)
+  /// Cost: O(spans x order^2) time and memory for that table.
   KnotVector(int order, std::vector<double> knots);
 
   /// A clamped knot vector on [a, b] with `segments` uniform intervals.
@@ -82,7 +85,7 @@ public:
 
 private:
   const double* span_reciprocals(int span) const noexcept {
-    const int p = order_ - 1;
+    const std::ptrdiff_t p = order_ - 1;
     return inv_.data() + (span - p) * (p * (p + 1) / 2);
   }
 
