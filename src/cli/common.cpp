@@ -6,8 +6,33 @@
 #include <iostream>
 
 #include "trivox/error.hpp"
+#include "trivox/limits.hpp"
 
 namespace trivox::cli {
+
+void add_limit_option(CLI::App& app) {
+  std::string names;
+  for (const auto& l : limit_table()) names += (names.empty() ? "" : ", ") + std::string(l.name);
+  app.add_option_function<std::vector<std::string>>(
+         "--limit",
+         [](const std::vector<std::string>& items) {
+           Limits limits = default_limits();
+           for (const auto& item : items) set_limit(limits, item, "--limit");
+           set_default_limits(limits);
+         },
+         "Set an input limit, repeatable (docs/limits.md): " + names)
+      ->type_name("NAME=N")
+      ->allow_extra_args(false)  // one NAME=N per --limit: the model's name is no limit
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+void apply_limits_environment() {
+  const char* env = std::getenv("TRIVOX_LIMITS");
+  if (env == nullptr || *env == '\0') return;
+  Limits limits = default_limits();
+  set_limits(limits, env, "TRIVOX_LIMITS");
+  set_default_limits(limits);
+}
 
 std::vector<double> parse_numbers(const std::string& text, std::size_t count, const std::string& option) {
   std::vector<double> out;

@@ -28,6 +28,18 @@ void add_validate(CLI::App& app, Common& common);
 void add_build(CLI::App& app, Common& common);
 void add_construct(CLI::App& app, Common& common);
 
+/// Registers the global option `--limit NAME=N` (repeatable; given before or after the command,
+/// thanks to fallthrough) on the main app: each sets one input limit (trivox/limits.hpp) in the
+/// process's default limits, which every model reader of every command uses. Applied while the
+/// command line is parsed, before any command runs. Cost: constant.
+/// @throws trivox::Error (bad_input) from the parse for an unknown limit or a malformed value
+void add_limit_option(CLI::App& app);
+
+/// Applies the environment variable TRIVOX_LIMITS ("NAME=N,NAME=N", the same names as --limit,
+/// which overrides it) to the process's default limits; nothing when it is unset or empty.
+/// @throws trivox::Error (bad_input) naming TRIVOX_LIMITS for an unknown limit or a bad value
+void apply_limits_environment();
+
 /// Parses "a,b,c" into exactly `count` finite numbers.
 /// @param option  the option's name, for the message ("--uvw")
 /// @throws trivox::Error (bad_input) naming the option, the offending text and what was expected

@@ -60,7 +60,9 @@ int main(int argc, char** argv) {
   trivox::cli::add_validate(app, common);
   trivox::cli::add_build(app, common);
   trivox::cli::add_construct(app, common);
+  trivox::cli::add_limit_option(app);
   try {
+    trivox::cli::apply_limits_environment();
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

@@ -30,6 +30,7 @@ struct Element {
 struct Source {
   const std::string& name;
   std::string_view text;
+  const Limits& limits;
 
   /// 1-based line of byte `offset`.
   std::size_t line_at(std::size_t offset) const {
@@ -52,6 +53,10 @@ struct Source {
 
   [[noreturn]] void fail(const Element& e, const std::string& what) const {
     throw Error(where(e) + ": " + what);
+  }
+  /// A value over a limit: the message ends with the limit's name and how to raise it.
+  [[noreturn]] void over(const Element& e, const std::string& what, const char* limit) const {
+    throw Error(where(e) + ": " + what + limit_hint(limit));
   }
 };
 
@@ -186,6 +191,11 @@ KnotVector read_knot_vector(const Source& src, const Element& e) {
   const int degree =
       read_int_attribute(src, e, "degree", 0, 1 << 20, "degree=\"p\" with 0 <= p <= 1048576");
   const int order = degree + 1;
+  if (order > src.limits.max_order)
+    src.over(e, "degree=" + quoted(std::to_string(degree)) + "; expected a degree of at most " +
+                    std::to_string(src.limits.max_order - 1) + " (an order of at most " +
+                    std::to_string(src.limits.max_order) + ")",
+             "max_order");
   std::vector<double> knots = read_numbers(src, e);
   for (std::size_t i = 1; i < knots.size(); ++i)
     if (knots[i] < knots[i - 1])
@@ -250,6 +260,11 @@ std::vector<double> read_coefs(const Source& src, const Element& coefs, std::int
                                const std::string& counts_text, int& geo_dim, int& dim) {
   geo_dim = read_int_attribute(src, coefs, "geoDim", 2, 1 << 16,
                                "geoDim=\"d\" with d >= 2 (coordinates per point)");
+  if (geo_dim - 3 > src.limits.max_properties)
+    src.over(coefs, "geoDim=" + quoted(std::to_string(geo_dim)) + " (" + std::to_string(geo_dim - 3) +
+                        " properties); expected at most " + std::to_string(src.limits.max_properties) +
+                        " properties, geoDim " + std::to_string(src.limits.max_properties + 3),
+             "max_properties");
   const std::vector<double> v = read_numbers(src, coefs);
   const std::int64_t expected = saturating_product(geo_dim, count);
   if (static_cast<std::int64_t>(v.size()) != expected)
@@ -295,6 +310,10 @@ spline::TensorSpline<P> read_geometry(const Source& src, const Element& geom, bo
     count = saturating_product(count, knots[d].size());
     counts_text += (d ? " x " : "") + std::to_string(knots[d].size());
   }
+  if (count > src.limits.max_points)
+    src.over(basis, counts_text + " control points (from the knot vectors); expected at most " +
+                        std::to_string(src.limits.max_points) + " per patch",
+             "max_points");
   std::vector<double> weights;
   if (rational)
     weights = read_weights(src, require_child(src, nurbs, "weights", "a <weights> list"), count);
@@ -345,8 +364,8 @@ pugi::xml_node parse(const Source& src, pugi::xml_document& doc) {
 
 }  // namespace
 
-vmodel::VModel read_gismo_xml(std::string_view text, const std::string& source) {
-  const Source src{source, text};
+vmodel::VModel read_gismo_xml(std::string_view text, const std::string& source, const Limits& limits) {
+  const Source src{source, text, limits};
   pugi::xml_document doc;
   const Element root{parse(src, doc), "xml"};
   vmodel::VModel model;
@@ -356,6 +375,10 @@ vmodel::VModel read_gismo_xml(std::string_view text, const std::string& source) 
     std::string path = "Geometry[" + std::to_string(index) + "]";
     if (auto id = g.attribute("id")) path += " (id=" + quoted(id.value()) + ")";
     const Element e{g, path};
+    if (index >= limits.max_cells)
+      src.over(e, "more than " + std::to_string(limits.max_cells) + " geometries; expected at most " +
+                      std::to_string(limits.max_cells) + " cells and surfaces",
+               "max_cells");
     const GeometryKind kind = geometry_kind(g.attribute("type").value());
     std::string name = std::string("patch").append(std::to_string(index++));
     if (kind.params == 3)

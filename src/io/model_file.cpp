@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -149,9 +150,10 @@ void check_magnitudes(const spline::TensorSpline<P>& s, const std::string& where
 
 }  // namespace
 
-vmodel::VModel read_model(std::string_view text, const std::string& source) {
+vmodel::VModel read_model(std::string_view text, const std::string& source, const Limits& limits) {
   const ModelFormat format = detect_model_format(text, source);
-  vmodel::VModel m = format == ModelFormat::json ? read_model_json(text, source) : read_gismo_xml(text, source);
+  vmodel::VModel m = format == ModelFormat::json ? read_model_json(text, source, limits)
+                                                 : read_gismo_xml(text, source, limits);
   const bool json = format == ModelFormat::json;
   for (std::size_t i = 0; i < m.cells.size(); ++i)
     check_magnitudes(m.cells[i].volume,
@@ -180,9 +182,42 @@ std::string read_file(const fs::path& path) {
   return std::move(bytes).str();
 }
 
-vmodel::VModel load_model(const fs::path& path) {
-  const std::string text = read_file(path);
-  return read_model(text, path.string());
+std::string read_file(const fs::path& path, const Limits& limits) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (!fs::exists(st))
+    throw Error(name + ": no such file; expected an existing model file (.json or G+Smo .xml)");
+  if (fs::is_directory(st))
+    throw Error(name + ": is a folder; expected a model file (.json or G+Smo .xml)");
+  Fd fd(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+  if (fd.get() < 0) throw Error(name + ": cannot open: " + system_reason(errno) + "; expected a readable file");
+  const auto too_big = [&](const std::string& size) {
+    return Error(name + ": file size: " + size + "; expected at most " + std::to_string(limits.max_file_bytes) +
+                 " bytes" + limit_hint("max_file_bytes"));
+  };
+  struct stat info {};
+  std::string bytes;
+  if (::fstat(fd.get(), &info) == 0 && S_ISREG(info.st_mode)) {
+    if (info.st_size > limits.max_file_bytes) throw too_big(std::to_string(info.st_size) + " bytes");
+    bytes.reserve(static_cast<std::size_t>(info.st_size));
+  }
+  char chunk[1 << 16];
+  while (true) {
+    const ssize_t n = ::read(fd.get(), chunk, sizeof chunk);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw Error(name + ": cannot read: " + system_reason(errno) + "; expected a readable file");
+    if (n == 0) break;
+    if (static_cast<std::int64_t>(bytes.size()) + n > limits.max_file_bytes)
+      throw too_big("more than " + std::to_string(limits.max_file_bytes) + " bytes");
+    bytes.append(chunk, static_cast<std::size_t>(n));
+  }
+  return bytes;
+}
+
+vmodel::VModel load_model(const fs::path& path, const Limits& limits) {
+  const std::string text = read_file(path, limits);
+  return read_model(text, path.string(), limits);
 }
 
 void sync_folder_contents(const fs::path& dir) {

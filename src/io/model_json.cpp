@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "json_io.hpp"
+#include "model_scan.hpp"
 #include "trivox/spline/extract.hpp"
 
 #include "trivox/error.hpp"
@@ -366,8 +367,9 @@ bool known_units(std::string_view units) noexcept {
   return false;
 }
 
-vmodel::VModel read_model_json(std::string_view text, const std::string& source) {
+vmodel::VModel read_model_json(std::string_view text, const std::string& source, const Limits& limits) {
   const Source src{source};
+  scan_model_json(text, source, limits);  // limits and counts before the tree is built
   const json root = parse(src, text);
   expect_object(src, root, "", "a trivox model object {\"trivox\": 1, ...}");
   check_version(src, root);

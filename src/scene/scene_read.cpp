@@ -6,10 +6,12 @@
 #include <map>
 
 #include "../io/json_io.hpp"
+#include "../io/model_scan.hpp"
 #include "scene_construct.hpp"
 
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/limits.hpp"
 #include "trivox/spline/extract.hpp"
 
 namespace trivox::scene {
@@ -434,6 +436,9 @@ construct::Field detail::read_field(const Source& src, const json& j, const std:
 
 Scene read_scene_json(std::string_view text, const std::string& source) {
   const Source src{source};
+  // The trivariate cells and surfaces a scene holds obey the model limits (trivox/limits.hpp),
+  // checked before the tree is built.
+  io::scan_model_json(text, source, default_limits());
   const json root = parse(src, text);
   expect_object(src, root, "", "a trivox scene object {\"trivox\": 1, \"cells\": [...], ...}");
   check_version(src, root);
@@ -451,6 +456,8 @@ Scene read_scene_json(std::string_view text, const std::string& source) {
   return scene;
 }
 
-Scene load_scene(const std::filesystem::path& path) { return read_scene_json(io::read_file(path), path.string()); }
+Scene load_scene(const std::filesystem::path& path) {
+  return read_scene_json(io::read_file(path, default_limits()), path.string());
+}
 
 }  // namespace trivox::scene

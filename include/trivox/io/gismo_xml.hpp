@@ -15,11 +15,16 @@
 /// `cube.xml: Geometry[3] (id="1") / Basis type="TensorBSplineBasis3" / Basis index="1" /
 /// KnotVector (line 81): knot 3 (0.5) is less than knot 2 (1); expected non-decreasing knots`.
 ///
+/// Limits (trivox/limits.hpp): degrees (max_order - 1), control points per patch (max_points, from
+/// the knot vectors before the coefficients are read), geometries (max_cells) and properties
+/// (geoDim - 3, max_properties) are checked where the file declares them.
+///
 /// Cost: linear in the text size; pugixml holds the document tree while the model is built.
 #pragma once
 #include <string>
 #include <string_view>
 
+#include "trivox/limits.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
 namespace trivox::io {
@@ -31,7 +36,8 @@ namespace trivox::io {
 ///          trivariate and one surface per surface patch
 /// @throws trivox::Error (bad_input) on malformed XML (with its line and column), an unknown
 ///         geometry or basis type, bad knot vectors, a coefficient or weight count that does not
-///         match the basis, non-finite numbers or differing geoDims
-vmodel::VModel read_gismo_xml(std::string_view text, const std::string& source);
+///         match the basis, non-finite numbers or differing geoDims, or a value over a limit
+vmodel::VModel read_gismo_xml(std::string_view text, const std::string& source,
+                              const Limits& limits = default_limits());
 
 }  // namespace trivox::io

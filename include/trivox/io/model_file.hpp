@@ -7,12 +7,17 @@
 /// temporary file in the target's folder, flushes it to disk and renames it over the target, so
 /// a reader never sees a partial file under the final name, even if trivox is killed mid-write.
 ///
+/// Reading obeys the limits (trivox/limits.hpp): `load_model` refuses a file above max_file_bytes
+/// from its size before reading a byte (and stops reading one that grows, or a device that never
+/// ends, at the limit); the readers check the rest.
+///
 /// Cost: one read (or write) of the file plus the parse (or format), linear in its size.
 #pragma once
 #include <filesystem>
 #include <string>
 #include <string_view>
 
+#include "trivox/limits.hpp"
 #include "trivox/vmodel/vmodel.hpp"
 
 namespace trivox::io {
@@ -27,13 +32,16 @@ enum class ModelFormat {
 /// @throws trivox::Error (bad_input) for an empty file or one starting with anything else
 ModelFormat detect_model_format(std::string_view text, const std::string& source);
 
-/// Parses `text` with the reader its content calls for.
-vmodel::VModel read_model(std::string_view text, const std::string& source);
+/// Parses `text` with the reader its content calls for, within `limits` (all but max_file_bytes).
+/// @throws trivox::Error (bad_input) for every problem the readers report
+vmodel::VModel read_model(std::string_view text, const std::string& source,
+                          const Limits& limits = default_limits());
 
 /// Reads and parses the model file at `path`; messages name the file as `path.string()`.
-/// @throws trivox::Error (bad_input) when the file is missing, a directory or unreadable, and
-///         for every problem the readers report
-vmodel::VModel load_model(const std::filesystem::path& path);
+/// @param limits  the limits the file must keep; by default the process's (trivox/limits.hpp)
+/// @throws trivox::Error (bad_input) when the file is missing, a directory, unreadable or larger
+///         than limits.max_file_bytes, and for every problem the readers report
+vmodel::VModel load_model(const std::filesystem::path& path, const Limits& limits = default_limits());
 
 /// Writes `model` as a JSON model file at `path`, replacing any file there atomically.
 /// @throws trivox::Error (bad_input) when `path` ends in `.xml` (trivox writes JSON only), when
@@ -43,6 +51,13 @@ void save_model(const vmodel::VModel& model, const std::filesystem::path& path);
 /// The whole content of a file, as bytes.
 /// @throws trivox::Error (bad_input) "<path>: no such file; expected ..." and similar
 std::string read_file(const std::filesystem::path& path);
+
+/// The whole content of an input file (model, scene) of at most limits.max_file_bytes: a larger
+/// regular file is refused from its size before a byte is read, and reading anything else (a
+/// pipe, a device) stops one byte past the limit. Memory: the file's size, at most the limit.
+/// @throws trivox::Error (bad_input) as read_file, and "<path>: file size: N bytes; expected at
+///         most M bytes (limit max_file_bytes; raise it with --limit max_file_bytes=N)"
+std::string read_file(const std::filesystem::path& path, const Limits& limits);
 
 /// When a written file reaches the disk.
 enum class Durability {
