@@ -9,7 +9,9 @@
 
 #include "../detail/json_text.hpp"
 #include "trivox/error.hpp"
+#include "trivox/io/gcvf.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/safe_path.hpp"
 
 namespace trivox::job {
 
@@ -20,6 +22,8 @@ using json = nlohmann::json;
 
 constexpr int manifest_version = 1;
 constexpr int max_shards = 100000;
+/// A manifest takes about 250 bytes per layer: 256 MiB holds a million layers.
+constexpr std::int64_t max_manifest_bytes = std::int64_t{256} << 20;
 
 /// Typed access with "<source>: <pointer>: found ...; expected ..." messages.
 struct Reader {
@@ -65,6 +69,16 @@ struct Reader {
 
 std::string shard_suffix(const Shard& s) {
   return ".shard-" + std::to_string(s.index) + "-of-" + std::to_string(s.count);
+}
+
+/// "slice_<digits>.png" whose digits (zero padding allowed) read `index`.
+bool is_slice_name(const std::string& name, int index) {
+  const std::string head = io::StackConfig{}.prefix, tail = ".png";
+  if (name.size() <= head.size() + tail.size() || !name.starts_with(head) || !name.ends_with(tail)) return false;
+  const std::string digits = name.substr(head.size(), name.size() - head.size() - tail.size());
+  if (digits.size() > 18 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return false;
+  return std::stoll(digits) == index;
 }
 
 }  // namespace
@@ -304,8 +318,29 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
   for (std::size_t i = 0; i < files.size(); ++i) {
     const std::string p = "/files/" + std::to_string(i);
     if (!files[i].is_object()) r.fail_type(p, files[i], "an object {\"role\", \"file\", \"sha256\"}");
-    m.files.push_back({r.string(r.member(files[i], p, "role"), p + "/role"), r.string(r.member(files[i], p, "file"), p + "/file"),
-                       r.sha(r.member(files[i], p, "sha256"), p + "/sha256")});
+    ManifestFile f{r.string(r.member(files[i], p, "role"), p + "/role"), r.string(r.member(files[i], p, "file"), p + "/file"),
+                   r.sha(r.member(files[i], p, "sha256"), p + "/sha256")};
+    if (f.role != "config" && f.role != "vdb" && f.role != "zip")
+      r.fail_type(p + "/role", files[i]["role"], "\"config\", \"vdb\" or \"zip\"");
+    for (const ManifestFile& g : m.files)
+      if (g.role == f.role) r.fail_type(p + "/role", files[i]["role"], "each role once");
+    // The names are turned into paths (resume, --force, merge): each must be the one trivox
+    // writes for its role, a plain name inside the folder (the zip: beside it).
+    const json& name = files[i]["file"];
+    if (f.role == "zip") {
+      const std::string base = f.file.starts_with("../") ? f.file.substr(3) : std::string();
+      if (!io::plain_file_name(base) || !base.ends_with(".gcvf") || base.size() <= 5)
+        r.fail_type(p + "/file", name, "\"../<folder>.gcvf\", the archive beside the folder");
+    } else if (!io::plain_file_name(f.file)) {
+      r.fail_type(p + "/file", name, "a file name inside the folder");
+    } else if (f.role == "config" && f.file != "ConfigFile.xml") {
+      r.fail_type(p + "/file", name, "\"ConfigFile.xml\" for role config");
+    } else if (f.role == "vdb") {
+      const std::string tail = (m.shard.count > 1 ? shard_suffix(m.shard) : std::string()) + ".vdb";
+      if (f.file.size() <= tail.size() || !f.file.ends_with(tail))
+        r.fail_type(p + "/file", name, "a VDB named <model>" + tail + " for role vdb");
+    }
+    m.files.push_back(std::move(f));
   }
   const auto& layers = r.array(r.member(root, "", "layers"), "/layers", "layers");
   for (std::size_t i = 0; i < layers.size(); ++i) {
@@ -317,9 +352,10 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
     if (!m.layers.empty() && ml.index <= m.layers.back().index)
       r.fail_type(p + "/index", l["index"], "layers in ascending order, each once");
     ml.file = r.string(r.member(l, p, "file"), p + "/file");
-    if (ml.file.empty() || ml.file.find('/') != std::string::npos || ml.file.find('\\') != std::string::npos ||
-        ml.file == "." || ml.file == "..")
-      r.fail_type(p + "/file", l["file"], "a file name inside the folder");
+    if (!io::plain_file_name(ml.file)) r.fail_type(p + "/file", l["file"], "a file name inside the folder");
+    if (!is_slice_name(ml.file, ml.index))
+      r.fail_type(p + "/file", l["file"], "slice_" + std::to_string(ml.index) + ".png (zero-padded or not), the name of layer " +
+                                              std::to_string(ml.index));
     ml.sha256 = r.sha(r.member(l, p, "sha256"), p + "/sha256");
     const auto& vox = r.array(r.member(l, p, "voxels"), p + "/voxels", "voxel counts");
     if (vox.size() != m.materials.size())
@@ -334,9 +370,17 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
 
 std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name) {
   const auto path = dir / name;
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return std::nullopt;
-  return parse_manifest(io::read_file(path), path.string());
+  const std::optional<std::string> text = io::read_regular_file(path, max_manifest_bytes);
+  if (!text) return std::nullopt;
+  return parse_manifest(*text, path.string());
 }
+
+std::string vdb_file_name(const Manifest& m) {
+  std::string stem = std::filesystem::path(m.model_file).stem().string();
+  if (stem.empty() || !io::plain_file_name(stem + ".vdb")) stem = "model";
+  return stem + ".vdb";
+}
+
+std::string zip_entry_name(const std::filesystem::path& dir) { return "../" + io::gcvf_path(dir).filename().string(); }
 
 }  // namespace trivox::job

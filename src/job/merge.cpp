@@ -7,7 +7,9 @@
 #include <optional>
 
 #include "trivox/error.hpp"
+#include "trivox/io/gcvf.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/safe_path.hpp"
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/slice_stack.hpp"
 #include "trivox/io/vdb_merge.hpp"
@@ -33,9 +35,29 @@ std::optional<Shard> shard_of_name(const std::string& name) {
   }
 }
 
-bool file_matches(const fs::path& path, const std::string& sha) {
-  std::error_code ec;
-  return fs::is_regular_file(path, ec) && io::sha256_file(path) == sha;
+/// A regular file (not a link: links out of the folder are never followed) with digest `sha`.
+bool file_matches(const fs::path& path, const std::string& sha) { return io::sha256_regular_file(path) == sha; }
+
+/// Where a part's `files` entry lives, derived from the job and the folder, never from the
+/// entry's string (which must equal what the shard writes); empty with the reason in `why`.
+fs::path part_file(const fs::path& dir, const Manifest& job, const Shard& shard, const ManifestFile& f, std::string& why) {
+  std::string expected;
+  fs::path path;
+  if (f.role == "vdb") {
+    expected = shard.part_name(vdb_file_name(job));
+    path = dir / expected;
+  } else if (f.role == "zip") {
+    expected = zip_entry_name(dir);
+    path = io::gcvf_path(dir);
+  } else {
+    expected = "ConfigFile.xml";
+    path = dir / expected;
+  }
+  if (f.file != expected) {
+    why = "lists its " + f.role + " file as \"" + f.file + "\"; expected \"" + expected + "\"";
+    return {};
+  }
+  return path;
 }
 
 }  // namespace
@@ -108,9 +130,16 @@ MergeSummary merge_job(const fs::path& dir) {
         std::vector<std::string> bad;
         for (std::size_t i = 0; i < ok.size(); ++i)
           if (!ok[i]) bad.push_back(m.layers[i].file);
-        for (const auto& f : m.files)
-          if (!file_matches(dir / f.file, f.sha256)) bad.push_back(f.file);
-        if (!bad.empty())
+        for (const auto& f : m.files) {
+          std::string why;
+          const fs::path path = part_file(dir, job, s, f, why);
+          if (path.empty()) {
+            problem = why;
+            break;
+          }
+          if (!file_matches(path, f.sha256)) bad.push_back(f.file);
+        }
+        if (problem.empty() && !bad.empty())
           problem = std::to_string(bad.size()) + " file(s) missing or changed since the shard wrote them (" + bad.front() +
                     (bad.size() > 1 ? ", ..." : "") + ")";
       }
@@ -141,8 +170,10 @@ MergeSummary merge_job(const fs::path& dir) {
   sum.layers = nz;
   sum.materials = job.materials;
   sum.material_voxels.assign(job.materials.size(), 0);
+  // The merged VDB's name and its parts' come from the job (the model's name), not from the
+  // strings of the parts, which were checked above to be those names.
   std::vector<fs::path> vdb_parts;
-  std::string vdb_name;
+  const std::string vdb_name = vdb_file_name(job);
   for (const auto& [k, m] : parts) {
     for (const auto& l : m.layers) {
       merged.layers.push_back(l);
@@ -150,14 +181,7 @@ MergeSummary merge_job(const fs::path& dir) {
       sum.inversion_failures += l.failures;
     }
     for (const auto& f : m.files)
-      if (f.role == "vdb") {
-        vdb_parts.push_back(dir / f.file);
-        // model.shard-K-of-N.vdb -> model.vdb
-        const std::string suffix = ".shard-" + std::to_string(k) + "-of-" + std::to_string(n);
-        std::string name = f.file;
-        if (const auto at = name.rfind(suffix); at != std::string::npos) name.erase(at, suffix.size());
-        vdb_name = name;
-      }
+      if (f.role == "vdb") vdb_parts.push_back(dir / Shard{k, n}.part_name(vdb_name));
   }
   if (!vdb_parts.empty() && static_cast<int>(vdb_parts.size()) != n)
     throw Error(dir.string() + ": only " + std::to_string(vdb_parts.size()) + " of " + std::to_string(n) +

@@ -12,6 +12,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
+#include <functional>
 #include <future>
 #include <map>
 #include <optional>
@@ -22,6 +24,7 @@
 #include "../io/png_rows.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/safe_path.hpp"
 #include "trivox/io/sha256.hpp"
 #include "trivox/io/gcvf.hpp"
 #include "trivox/io/png_image.hpp"
@@ -113,6 +116,25 @@ inline void lap(double& t, double& acc) {
   t = now;
 }
 
+/// Runs `f` when the scope is left by an exception (not on a normal exit), swallowing what `f`
+/// throws: the exception in flight is the one to report.
+class OnUnwind {
+public:
+  explicit OnUnwind(std::function<void()> f) : f_(std::move(f)), exceptions_(std::uncaught_exceptions()) {}
+  OnUnwind(const OnUnwind&) = delete;
+  OnUnwind& operator=(const OnUnwind&) = delete;
+  ~OnUnwind() {
+    if (std::uncaught_exceptions() > exceptions_) try {
+        f_();
+      } catch (...) {
+      }
+  }
+
+private:
+  std::function<void()> f_;
+  int exceptions_;
+};
+
 /// One layer on its way through the pipeline.
 struct LayerOut {
   int layer = -1;
@@ -123,15 +145,60 @@ struct LayerOut {
 };
 
 
-/// What --force (without --resume) removes before a job writes anything, so that the folder ends
-/// up holding this job alone and never looks complete while it does not: ConfigFile.xml first (a
-/// stack without it is unfinished to every reader), then the earlier jobs' manifests with the
-/// files they list, then the slices this job will not overwrite (past the new stack's end; all
-/// of them for a volume-only job). Slices it will overwrite stay until replaced (each by a
-/// rename): removing them first would double the folder's metadata writes, about 3.5 ms a file
-/// on a journalling disk, for a folder that already says it is unfinished. Sibling shards share
-/// the folder: only the last removes slices past the end, and none removes a manifest of the
-/// same job, so none removes another's work. Files that trivox does not write stay.
+/// A note to the user on stderr: what a job did to a folder beyond writing its own files.
+void note(const std::string& text) { std::fprintf(stderr, "trivox: note: %s\n", text.c_str()); }
+
+bool is_png_job(const Manifest& id) { return id.options.count("png") == 0 || id.options.at("png") != "no"; }
+
+/// "slice_<digits>.png": a file of trivox's slice naming, and its number.
+std::optional<long long> slice_number(const std::string& name) {
+  const std::string head = io::StackConfig{}.prefix, tail = ".png";
+  if (name.size() <= head.size() + tail.size() || !name.starts_with(head) || !name.ends_with(tail)) return std::nullopt;
+  const std::string digits = name.substr(head.size(), name.size() - head.size() - tail.size());
+  if (digits.size() > 18 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return std::nullopt;
+  return std::stoll(digits);
+}
+
+/// Whether `name` is one of the outputs of job `id` (this shard's, for a shard): its slices, its
+/// manifest, ConfigFile.xml and the VDB of a whole job, its own VDB part and write probe.
+bool job_output_name(const Manifest& id, const std::string& name) {
+  const bool whole = id.shard.count == 1;
+  if (const auto n = slice_number(name)) return whole || (*n >= id.layer_range[0] && *n < id.layer_range[1]);
+  if (whole) return is_manifest_name(name) || name == "ConfigFile.xml" || name == vdb_file_name(id) || name.starts_with(".trivox-write-test");
+  return name == id.shard.manifest_name() || name == id.shard.part_name(vdb_file_name(id)) ||
+         name == ".trivox-write-test-" + std::to_string(id.shard.index);
+}
+
+/// Moves a manifest that does not parse out of the way: `NAME.damaged-<n>`, the first n free.
+std::string move_aside(const fs::path& dir, const std::string& name) {
+  std::error_code ec;
+  for (int n = 1; n < 1000000; ++n) {
+    const std::string to = name + ".damaged-" + std::to_string(n);
+    if (fs::exists(fs::symlink_status(dir / to, ec))) continue;
+    fs::rename(dir / name, dir / to, ec);
+    if (ec)
+      throw Error((dir / name).string() + ": cannot move it aside (" + ec.message() +
+                  "); expected a folder that --force may write");
+    return to;
+  }
+  throw Error((dir / name).string() + ": cannot move it aside: every name " + name +
+              ".damaged-<n> is taken; expected a folder that --force may write");
+}
+
+/// What --force (without --resume) removes before a job writes anything, in a folder that holds
+/// a readable trivox manifest, so that the folder ends up holding this job alone and never looks
+/// complete while it does not: ConfigFile.xml first (a stack without it is unfinished to every
+/// reader), then the files the earlier jobs' manifests list in the folder (their VDB) when their
+/// bytes still have the recorded SHA-256, then the slices (trivox's naming, `slice_<n>.png`) this
+/// job will not overwrite (past the new stack's end; all of them for a volume-only job), then the
+/// earlier manifests (last, so that a kill midway leaves a manifest and the next --force finishes
+/// the work). Slices it will overwrite stay until replaced (each by a rename): removing them
+/// first would double the folder's metadata writes, about 3.5 ms a file on a journalling disk,
+/// for a folder that already says it is unfinished. Sibling shards share the folder: only the
+/// last removes slices past the end, and none removes a manifest of the same job, so none
+/// removes another's work. Files of other names stay, and so does a listed file whose bytes
+/// changed (said on stderr).
 /// @param stale  the manifests in `dir` to remove (file name, content), with the files they list
 void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vector<std::pair<std::string, Manifest>>& stale) {
   const auto remove = [&](const fs::path& p) {
@@ -141,16 +208,23 @@ void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vecto
                         "); expected a folder that --force may overwrite");
   };
   remove(dir / "ConfigFile.xml");
-  for (const auto& [name, m] : stale) {
-    for (const ManifestFile& f : m.files)
-      if (!f.file.empty() && f.file.find('/') == std::string::npos && f.file != "." && f.file != "..") remove(dir / f.file);
-    remove(dir / name);
-  }
-  const bool png = id.options.count("png") == 0 || id.options.at("png") != "no";
+  for (const auto& [name, m] : stale)
+    for (const ManifestFile& f : m.files) {
+      // The archive lives beside the folder, outside it: a job with --zip replaces it.
+      if (f.role != "vdb") continue;
+      // parse_manifest checked the name: a plain name inside the folder.
+      const fs::path p = dir / f.file;
+      const auto sha = io::sha256_regular_file(p);
+      if (sha == f.sha256) remove(p);
+      else if (sha || fs::exists(fs::symlink_status(p)))
+        note(p.string() + ": kept: listed by " + name + " but not the file it lists (changed since, or not a regular file)");
+    }
+  const bool png = is_png_job(id);
   const bool last = id.shard.index == id.shard.count - 1;
-  if (png && !last) return;
-  for (const auto& [n, name] : io::detail::list_slices(dir, io::StackConfig{}.prefix))
-    if (!png || n >= id.layer_range[1]) remove(dir / name);
+  if (!png || last)
+    for (const auto& [n, name] : io::detail::list_slices(dir, io::StackConfig{}.prefix))
+      if (!png || n >= id.layer_range[1]) remove(dir / name);
+  for (const auto& [name, m] : stale) remove(dir / name);
 }
 
 }  // namespace
@@ -161,14 +235,29 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
   if (fs::exists(dir, ec)) {
     if (!fs::is_directory(dir, ec))
       throw Error(dir.string() + ": exists and is not a folder; expected a new or empty folder for the slices");
-    bool empty = true, same_job_there = false;
+    bool empty = true, same_job_there = false, trivox_folder = false;
     std::vector<std::pair<std::string, Manifest>> stale;  // manifests that --force removes
+    std::vector<std::string> damaged;                      // manifest names that do not parse
     for (const auto& entry : fs::directory_iterator(dir, ec)) {
       const std::string name = entry.path().filename().string();
       if (name.starts_with(".trivox-write-test")) continue;
       empty = false;
       if (!is_manifest_name(name)) continue;
-      const auto m = read_manifest(dir, name);
+      std::optional<Manifest> m;
+      try {
+        m = read_manifest(dir, name);
+      } catch (const Error& e) {
+        // Damaged, foreign (another program's manifest.json) or a link: --force moves it aside.
+        if (force) {
+          damaged.push_back(name);
+          continue;
+        }
+        throw Error(std::string(e.what()) +
+                    (resume ? " (--resume cannot continue from it; --force moves it aside and starts over)"
+                            : " (--force moves it aside and starts over)"));
+      }
+      if (!m) continue;  // gone since the listing
+      trivox_folder = true;
       if (const std::string why = id.difference(*m); !why.empty()) {
         if (!force)
           throw Error(dir.string() + ": holds another job (" + name + ": " + why +
@@ -189,7 +278,30 @@ std::optional<Manifest> prepare_job_folder(const fs::path& dir, const Manifest& 
       throw Error(dir.string() + ": the folder is not empty; expected a new or empty folder (" +
                   (same_job_there ? std::string("--resume to continue (or verify) the job there, ") : std::string()) +
                   "or --force to overwrite)");
-    if (!empty && force && !resume) clear_earlier_job(dir, id, stale);
+    for (const std::string& name : damaged)
+      note((dir / name).string() + ": not a manifest this trivox can read (damaged, another program's, or a link); moved aside to " +
+           move_aside(dir, name) + ", starting over");
+    if (!empty && force && !resume) {
+      if (trivox_folder) {
+        clear_earlier_job(dir, id, stale);
+      } else if (id.shard.count == 1) {
+        // Nothing proves that trivox wrote any file here: none is removed. The job's own names
+        // are replaced as it writes them; slices past its end stay, and are said.
+        long long beyond = 0;
+        const bool png = is_png_job(id);
+        for (const auto& [n, name] : io::detail::list_slices(dir, io::StackConfig{}.prefix))
+          if (!png || n >= id.layer_range[1]) ++beyond;
+        note(dir.string() + ": holds no trivox manifest, so --force removes nothing there: the files this job writes "
+             "replace any of the same names, and every other file stays" +
+             (beyond ? " (among them " + std::to_string(beyond) + " slice file(s) " +
+                           (png ? "past this job's last layer" : "of a PNG stack") + ")"
+                     : std::string()));
+      }
+    }
+    if (force || resume) {
+      const int removed = io::remove_stale_temporaries(dir, [&](const std::string& owner) { return job_output_name(id, owner); });
+      if (removed > 0) note(dir.string() + ": removed " + std::to_string(removed) + " temporary file(s) left by an earlier run");
+    }
   } else if ((!fs::create_directories(dir, ec) || ec) && !fs::is_directory(dir)) {  // a sibling shard may win
     throw Error(dir.string() + ": cannot create the folder (" + ec.message() + "); expected a writable location");
   }
@@ -341,10 +453,12 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     std::vector<char> keep(static_cast<std::size_t>(nz), 0);
     if (previous)
       tbb::parallel_for(manifest.layer_range[0], manifest.layer_range[1], [&](int k) {
+        // A layer that is a symbolic link (to a file elsewhere, whose bytes may match) is redone:
+        // the finished job must not depend on a file outside the folder. Its rename then
+        // replaces the link itself.
         const ManifestLayer* l = previous->layer(k);
-        std::error_code ec;
         const fs::path f = opt.out_dir / cfg.slice_name(k);
-        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && fs::is_regular_file(f, ec) && io::sha256_file(f) == l->sha256;
+        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && io::sha256_regular_file(f) == l->sha256;
       });
     for (int k = manifest.layer_range[0]; k < manifest.layer_range[1]; ++k)
       if (keep[static_cast<std::size_t>(k)]) finished.emplace(k, *previous->layer(k));
@@ -376,6 +490,13 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   // it was taken; one at a time (a period whose predecessor is still syncing is skipped).
   // std::async's future waits in its destructor, so an exception leaves no thread behind.
   std::future<void> pending_manifest;
+  // A job that stops on an error from here on (a full disk, a failing layer) first writes a last
+  // manifest listing the layers it finished, synced, so that --resume keeps them. Best effort:
+  // when that fails too (the disk is full), the original error is the one reported.
+  const OnUnwind last_words([&] {
+    if (pending_manifest.valid()) pending_manifest.wait();
+    write_manifest(false);
+  });
   auto write_manifest_behind = [&] {
     if (pending_manifest.valid()) {
       if (pending_manifest.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;

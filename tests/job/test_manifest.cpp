@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <map>
+#include <vector>
 #include <string>
 
 #include "trivox/error.hpp"
@@ -213,4 +214,63 @@ TEST_CASE("a PNG job's manifest records names, void and channels; earlier ones r
     check_message(error_of([&] { parse_manifest(manifest_json(m), "m.json"); }),
                   {"/options/png.background", "expected \"transparent\" or \"black\""});
   }
+}
+
+TEST_CASE("names that become paths are the ones trivox writes, inside the folder", "[manifest]") {
+  // sample(): shard 1 of 3, its VDB part col.shard-1-of-3.vdb.
+  const auto refusal = [](const std::vector<ManifestFile>& files) {
+    Manifest m = sample();
+    m.files = files;
+    return error_of([&] { parse_manifest(manifest_json(m), "m.json"); });
+  };
+  const std::string sha(64, 'c');
+  for (const char* bad : {"../outside/victim.vdb", "/etc/shadow", "a/b.vdb", "..", ".", "", "a\\b.vdb"})
+    check_message(refusal({{"vdb", bad, sha}}), {"m.json: /files/0/file: found the string", "expected a file name inside the folder"});
+  // A NUL inside the name (JSON "\u0000").
+  {
+    std::string t = manifest_json(sample());
+    const std::string from = "\"col.shard-1-of-3.vdb\"";
+    t.replace(t.find(from), from.size(), "\"col\\u0000.shard-1-of-3.vdb\"");
+    check_message(error_of([&] { parse_manifest(t, "m.json"); }), {"/files/0/file", "expected a file name inside the folder"});
+  }
+  check_message(refusal({{"config", "ConfigFile.xml", sha}, {"vdb", "../x", sha}}),
+                {"m.json: /files/1/file: found the string \"../x\"; expected a file name inside the folder"});
+  // Plain names, but not what trivox writes for the role.
+  check_message(refusal({{"vdb", "notes.txt", sha}}), {"/files/0/file", "expected a VDB named <model>.shard-1-of-3.vdb"});
+  check_message(refusal({{"vdb", "col.shard-0-of-3.vdb", sha}}), {"/files/0/file", "<model>.shard-1-of-3.vdb"});
+  check_message(refusal({{"vdb", ".shard-1-of-3.vdb", sha}}), {"/files/0/file"});
+  check_message(refusal({{"config", "notes.txt", sha}}), {"/files/0/file", "\"ConfigFile.xml\" for role config"});
+  check_message(refusal({{"zip", "x.gcvf", sha}}), {"/files/0/file", "\"../<folder>.gcvf\""});
+  check_message(refusal({{"zip", "../../x.gcvf", sha}}), {"/files/0/file", "\"../<folder>.gcvf\""});
+  check_message(refusal({{"zip", "/tmp/x.gcvf", sha}}), {"/files/0/file"});
+  check_message(refusal({{"model", "x.json", sha}}), {"/files/0/role", "expected \"config\", \"vdb\" or \"zip\""});
+  check_message(refusal({{"vdb", "col.shard-1-of-3.vdb", sha}, {"vdb", "col.shard-1-of-3.vdb", sha}}),
+                {"/files/1/role", "each role once"});
+  // What trivox writes reads back.
+  Manifest m = sample();
+  m.files = {{"config", "ConfigFile.xml", sha}, {"zip", "../col.gcvf", sha}, {"vdb", "col.shard-1-of-3.vdb", sha}};
+  CHECK(parse_manifest(manifest_json(m), "m.json").files == m.files);
+  // Layers: slice_<k>.png of their own index, padded or not.
+  const auto layer_refusal = [](const std::string& name) {
+    Manifest m = sample();
+    m.layers[0].file = name;
+    return error_of([&] { parse_manifest(manifest_json(m), "m.json"); });
+  };
+  check_message(layer_refusal("../slice_8.png"), {"/layers/0/file", "expected a file name inside the folder"});
+  check_message(layer_refusal("notes.txt"), {"/layers/0/file", "expected slice_8.png (zero-padded or not)"});
+  check_message(layer_refusal("slice_9.png"), {"/layers/0/file", "expected slice_8.png"});
+  m = sample();
+  m.layers[0].file = "slice_00008.png";
+  CHECK(parse_manifest(manifest_json(m), "m.json").layers[0].file == "slice_00008.png");
+}
+
+TEST_CASE("derived names: the whole VDB from the model's name, the archive from the folder's", "[manifest]") {
+  Manifest m = sample();
+  CHECK(vdb_file_name(m) == "twisted_column.vdb");
+  m.model_file = "";
+  CHECK(vdb_file_name(m) == "model.vdb");
+  m.model_file = "/some/where/../teapot.json";
+  CHECK(vdb_file_name(m) == "teapot.vdb");
+  CHECK(zip_entry_name("jobs/teapot") == "../teapot.gcvf");
+  CHECK(zip_entry_name("jobs/teapot/") == "../teapot.gcvf");
 }

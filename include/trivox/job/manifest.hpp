@@ -117,13 +117,30 @@ io::StackConfig stack_config_of(const Manifest& manifest, const std::vector<std:
 /// The manifest as JSON text (2-space indented, keys in a fixed order, ending with a newline).
 std::string manifest_json(const Manifest& manifest);
 
-/// Parses a manifest.
+/// Parses a manifest. Every name that trivox turns into a path is checked to be the one trivox
+/// writes, inside the folder (io/safe_path.hpp `plain_file_name`): a layer's file is
+/// `slice_<k>.png` (zero-padded or not) for its index k; `files` roles are "config"
+/// (`ConfigFile.xml`), "vdb" (`<model>.vdb`, a shard's `<model>.shard-K-of-N.vdb` of its own K
+/// and N), "zip" (`../<folder>.gcvf`, whose folder name the reader compares with the folder it
+/// read), each at most once. A path with a separator, `..`, an absolute path or a NUL is refused.
 /// @param source  the file name, for messages
-/// @throws Error (bad_input) "<source>: <JSON pointer>: ...; expected ..." for anything malformed
+/// @throws Error (bad_input) "<source>: <JSON pointer>: ...; expected ..." for anything malformed,
+///         e.g. "m.json: /files/0/file: found the string \"../x\"; expected a file name inside
+///         the folder"
 Manifest parse_manifest(std::string_view text, const std::string& source);
 
-/// Reads `dir / name` when it exists; nothing when it does not.
-/// @throws Error (bad_input) when it exists but cannot be read or parsed
+/// Reads `dir / name` when it exists; nothing when it does not. The file is opened without
+/// following a symbolic link (io::read_regular_file) and may hold at most 256 MiB.
+/// @throws Error (bad_input) when it exists but is a link or not a regular file, is too large,
+///         cannot be read or does not parse
 std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name);
+
+/// The name of the job's whole VDB, derived from the model file's name: `<stem>.vdb`
+/// (`model.vdb` for a name without a stem), as the VDB job names it; always a plain file name.
+std::string vdb_file_name(const Manifest& manifest);
+
+/// The `files` entry that a `--zip` job in folder `dir` records for its archive:
+/// "../<folder name>.gcvf" (io::gcvf_path).
+std::string zip_entry_name(const std::filesystem::path& dir);
 
 }  // namespace trivox::job
