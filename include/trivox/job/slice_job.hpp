@@ -111,8 +111,15 @@ slice::VoxelGrid slice_grid(const vmodel::VModel& model, const slice::PrintProfi
 /// The output folder of a job with identity `id` (manifest.hpp), created if absent. A whole job
 /// without `resume` wants it new or empty (or `force`); shards share one folder with their
 /// siblings; any manifest in it must be of the same job (or `force`, which starts over).
+/// `force` without `resume` removes only what a readable trivox manifest there lists with its
+/// recorded SHA-256 and trivox's own names (docs/jobs.md, "Overwriting"); in a folder without
+/// one it removes nothing. With `force`, a manifest that does not parse (or is a link) is moved
+/// aside to `NAME.damaged-<n>`; `force` and `resume` remove this job's (shard's) stale
+/// temporaries. What it moved or kept is said on stderr ("trivox: note: ..."). Cost: a listing
+/// of the folder, a parse of each manifest, a SHA-256 of each listed VDB it may remove.
 /// @return this job's (shard's) manifest when resuming and there is one
-/// @throws Error (bad_input) naming the folder and the reason
+/// @throws Error (bad_input) naming the folder and the reason, among them a manifest that does
+///         not parse without `force` (its message says that --force moves it aside)
 std::optional<Manifest> prepare_job_folder(const std::filesystem::path& dir, const Manifest& id, bool force, bool resume);
 
 /// Marks the manifest of the job in `dir` (shard `shard`) complete, adding `files` (replacing
