@@ -13,6 +13,7 @@
 #include "trivox/error.hpp"
 #include "trivox/job/manifest.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/safe_path.hpp"
 #include "trivox/io/sha256.hpp"
 #include "trivox/job/slice_job.hpp"
 #include "trivox/job/vdb_job.hpp"
@@ -30,6 +31,7 @@ struct Options {
   int digits = 0;
   std::string background = "transparent";
   double max_voxels = 1e11;  // a double, so that 1e9 reads as the help writes it
+  std::string max_memory = "2G";
   bool png = false, vdb = false;
   double vdb_voxel = 0.0;
   std::string vdb_units = "mm", vdb_color_space = "linear";
@@ -38,6 +40,30 @@ struct Options {
   std::string shard;
   int shard_count = 0;
 };
+
+/// "2G", "1.5GiB", "512M", "800000000": a memory size in bytes (K, M, G, T are powers of 1024).
+std::int64_t parse_bytes(const std::string& text, const std::string& option) {
+  const auto bad = [&] {
+    return Error(option + " " + text + ": not a memory size; expected a number of bytes, or with K, M, G or T " +
+                 "(powers of 1024: 2G, 1.5GiB, 512M), from 64M to 1024T");
+  };
+  double v = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  if (ec != std::errc() || ptr == text.data() || !std::isfinite(v)) throw bad();
+  std::string unit(ptr, end);
+  if (unit.ends_with("iB")) unit.resize(unit.size() - 2);
+  else if (unit.ends_with("B")) unit.resize(unit.size() - 1);
+  double scale = 1;
+  if (unit == "K" || unit == "k") scale = 1024.0;
+  else if (unit == "M") scale = 1024.0 * 1024;
+  else if (unit == "G") scale = 1024.0 * 1024 * 1024;
+  else if (unit == "T") scale = 1024.0 * 1024 * 1024 * 1024;
+  else if (!unit.empty()) throw bad();
+  const double bytes = v * scale;
+  if (!(bytes >= 64.0 * 1024 * 1024 && bytes <= 1024.0 * 1024 * 1024 * 1024 * 1024)) throw bad();
+  return static_cast<std::int64_t>(bytes);
+}
 
 std::string duration(double s) {
   char buf[32];
@@ -112,6 +138,7 @@ nlohmann::ordered_json vdb_json(const job::VdbJobSummary& v) {
           {"samples", v.samples},
           {"volume_mm3", v.volume_mm3},
           {"estimated_volume_mm3", v.plan.estimated_volume_mm3},
+          {"estimated_memory_bytes", v.plan.estimated_memory_bytes},
           {"colour_source", v.colour_source},
           {"units", v.units},
           {"color_space", v.color_space},
@@ -130,14 +157,14 @@ void print_vdb(const job::VdbJobSummary& v) {
   std::printf("vdb: %s: %zu grids (%s), %s\n", v.file.string().c_str(), v.grids.size(), grids.c_str(),
               human_bytes(static_cast<double>(v.bytes)).c_str());
   if (p.automatic)
-    std::printf("voxel %s mm (automatic: volume %s mm^3 / voxel^3 = about %.3g active voxels, below %.3g), supersample %d\n",
+    std::printf("voxel %s mm (automatic: volume %s mm^3 / voxel^3 = about %.3g active voxels, below %.3g and within the memory), supersample %d\n",
                 fmt(p.voxel_mm, 6).c_str(), fmt(p.estimated_volume_mm3, 8).c_str(), p.estimated_active_voxels, 5e7,
                 p.supersample);
   else
     std::printf("voxel %s mm (--vdb-voxel), supersample %d\n", fmt(p.voxel_mm, 6).c_str(), p.supersample);
-  std::printf("box %d x %d x %d voxels from (%s, %s, %s) mm; time %s\n", p.count[0], p.count[1], p.count[2],
-              fmt(p.origin[0], 6).c_str(), fmt(p.origin[1], 6).c_str(), fmt(p.origin[2], 6).c_str(),
-              duration(v.seconds).c_str());
+  std::printf("box %d x %d x %d voxels from (%s, %s, %s) mm; time %s; memory estimated %s (--max-memory)\n", p.count[0],
+              p.count[1], p.count[2], fmt(p.origin[0], 6).c_str(), fmt(p.origin[1], 6).c_str(), fmt(p.origin[2], 6).c_str(),
+              duration(v.seconds).c_str(), human_bytes(p.estimated_memory_bytes).c_str());
   std::printf("active voxels %lld (%lld fractional), volume %s mm^3 (quadrature %s mm^3)\n",
               static_cast<long long>(v.active_voxels), static_cast<long long>(v.fractional_voxels),
               fmt(v.volume_mm3, 8).c_str(), fmt(p.estimated_volume_mm3, 8).c_str());
@@ -172,6 +199,8 @@ void add_slice(CLI::App& app, Common& common) {
                   "Void pixels: transparent (0 0 0 0, default) or black (0 0 0 255); declared in ConfigFile.xml");
   sub->add_flag("--force", opt->force, "Write into a non-empty folder; allow jobs beyond the tray or --max-voxels");
   sub->add_option("--max-voxels", opt->max_voxels, "Refuse larger grids unless --force (default 1e11)");
+  sub->add_option("--max-memory", opt->max_memory,
+                  "Memory the VDB job may use: its automatic voxel fits, a finer --vdb-voxel is refused (default 2G)");
   sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)");
   sub->add_option("--progress", opt->progress, "auto (bar on a terminal, lines otherwise), bar, lines, never");
   sub->add_flag("--png", opt->png, "Write the PNG stack (the default without --vdb)");
@@ -189,7 +218,7 @@ void add_slice(CLI::App& app, Common& common) {
   sub->callback([opt, &common, sub] {
     const bool want_vdb = opt->vdb, want_png = opt->png || !opt->vdb;
     if (!want_vdb)
-      for (const char* o : {"--vdb-voxel", "--vdb-units", "--vdb-color-space", "--supersample"})
+      for (const char* o : {"--vdb-voxel", "--vdb-units", "--vdb-color-space", "--supersample", "--max-memory"})
         if (sub->count(o) > 0) throw Error(std::string(o) + ": applies to the VDB output; expected --vdb with it");
     if (!want_png)
       for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels", "--digits", "--background"})
@@ -226,6 +255,7 @@ void add_slice(CLI::App& app, Common& common) {
       if (!opt->palette.empty()) vj.palette = opt->palette;
       if (sub->count("--vdb-voxel") > 0) vj.voxel_mm = opt->vdb_voxel;
       vj.supersample = opt->supersample;
+      vj.max_memory_bytes = parse_bytes(opt->max_memory, "--max-memory");
       vj.force = opt->force;
       vj.require_empty_folder = !want_png;
       plan = job::plan_vdb_job(model, vj);  // bad VDB options fail before the PNG stack is written
@@ -258,11 +288,15 @@ void add_slice(CLI::App& app, Common& common) {
     vj.model_sha256 = model_sha;  // the VDB's metadata: hashed once
     // A resumed job keeps its VDB when the manifest lists it and it verifies.
     auto verified_vdb = [&]() -> std::optional<job::ManifestFile> {
-      if (want_vdb && opt->resume)
-        if (const auto m = job::read_manifest(opt->out, shard.manifest_name()))
+      std::optional<job::Manifest> m;
+      if (want_vdb && opt->resume) try {
+          m = job::read_manifest(opt->out, shard.manifest_name());
+        } catch (const Error&) {
+        }
+      if (m)
           for (const auto& f : m->files)
             if (f.role == "vdb" && f.file == plan->file.filename().string() &&
-                std::filesystem::is_regular_file(plan->file) && io::sha256_file(plan->file) == f.sha256)
+                io::sha256_regular_file(plan->file) == f.sha256)
               return f;
       return std::nullopt;
     };
@@ -326,10 +360,13 @@ void add_slice(CLI::App& app, Common& common) {
     job.background = opt->background;
     // Resuming continues the job as it was named and painted: unless given again, the slice
     // names and the void colour are the manifest's (an earlier trivox's padded names included).
-    if (opt->resume)
-      if (const auto m = job::read_manifest(opt->out, shard.manifest_name())) {
-        if (sub->count("--digits") == 0 && m->options.count("png.digits")) job.digits = std::stoi(m->options.at("png.digits"));
-        if (sub->count("--background") == 0 && m->options.count("png.background")) job.background = m->options.at("png.background");
+    if (opt->resume) try {
+        if (const auto m = job::read_manifest(opt->out, shard.manifest_name())) {
+          if (sub->count("--digits") == 0 && m->options.count("png.digits")) job.digits = std::stoi(m->options.at("png.digits"));
+          if (sub->count("--background") == 0 && m->options.count("png.background")) job.background = m->options.at("png.background");
+        }
+      } catch (const Error&) {
+        // A damaged manifest: the job folder's check reports it (and --force moves it aside).
       }
     job.model_file = opt->model;
     job.model_sha256 = model_sha;

@@ -424,6 +424,26 @@ expect_fail "expected at least 1.44225e-05 mm, the smallest voxel OpenVDB's tran
   "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel 1e-7 --force
 expect_fail "a voxel of 1e-05 m; expected at least 0.0144225 mm" \
   "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --vdb-voxel 0.01 --vdb-units m --force
+# Memory: a voxel whose grids would not fit in --max-memory is refused before anything is
+# written; the automatic voxel fits, and the job's peak (resident set, measured by the kernel)
+# stays within it.
+expect_fail "an estimated .* of memory; expected at most 0.268 GB (raise --max-memory, or a larger --vdb-voxel)" \
+  "$trivox" slice models/graded_block.json -o "$tmp/x1" --vdb --vdb-voxel 0.05 --max-memory 256M --force
+expect_fail "--max-memory 64K: not a memory size" "$trivox" slice models/graded_block.json -o "$tmp/x1" --vdb --max-memory 64K
+expect_fail "--max-memory: applies to the VDB output" "$trivox" slice models/graded_block.json -o "$tmp/x1" --max-memory 1G
+"$py" - "$trivox" "$tmp/mem" <<'PY'
+import sys, json, resource, subprocess
+trivox, out = sys.argv[1:]
+limit = 300 * 2**20
+r = subprocess.run([trivox, "slice", "models/graded_block.json", "-o", out, "--vdb", "--max-memory", "300M", "--json",
+                    "--progress", "never"], capture_output=True, text=True)
+assert r.returncode == 0, r.stderr
+v = json.loads(r.stdout)["vdb"]
+peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024
+assert v["voxel_automatic"] and v["estimated_memory_bytes"] <= limit, v
+assert peak <= limit, (peak, limit, v["voxel_mm"])
+assert abs(v["volume_mm3"] - 9600) < 0.05 * 9600, v["volume_mm3"]     # the graded block's 40 x 20 x 12 mm
+PY
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --supersample 0
 expect_fail "expected 1 to 8" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --vdb --supersample 9
 expect_fail "expected --vdb with it" "$trivox" slice models/gismo/fichera.xml -o "$tmp/x1" --supersample 2

@@ -88,6 +88,10 @@ struct VdbJobOptions {
   bool require_empty_folder = true;   ///< false when the PNG stack was just written into out_dir
   std::int64_t max_dense_voxels = 2'000'000'000;      ///< refuse larger boxes unless force
   std::int64_t target_active_voxels = 50'000'000;     ///< what the automatic voxel size aims below
+  /// The memory the job may use (`--max-memory`): the automatic voxel size keeps the estimate
+  /// (VdbPlan::estimated_memory_bytes) within it, and a `voxel_mm` whose estimate exceeds it
+  /// is refused. 2 GiB by default.
+  std::int64_t max_memory_bytes = std::int64_t{2} << 30;
   /// Only the voxel layers [first, end) in z, first a multiple of 8 and end a multiple of 8 or
   /// the layer count (whole leaves): a shard's part, whose trees merged with the other parts'
   /// give the whole job's. Empty: every layer.
@@ -116,6 +120,12 @@ struct VdbPlan {
   std::int64_t dense_voxels = 0;         ///< count[0] * count[1] * count[2]
   double estimated_volume_mm3 = 0.0;     ///< sum of |cell volume| by Gauss quadrature (trivox info)
   double estimated_active_voxels = 0.0;  ///< estimated_volume_mm3 / voxel^3
+  int grids_values = 0;                  ///< floats stored per active voxel (density, colour, fractions, properties)
+  /// The job's peak memory, estimated (an upper estimate, within about 10 percent on the
+  /// examples): a base of 150 MB (the model and its locator) + the active voxels of this job's
+  /// layers x grids_values x 4 bytes x 1.2 (OpenVDB's leaves also hold their inactive voxels'
+  /// values near the surface) + each worker's task sums.
+  double estimated_memory_bytes = 0.0;
   std::filesystem::path file;            ///< out_dir / (stem + ".vdb")
 };
 
@@ -144,10 +154,13 @@ struct VdbJobSummary {
 using VdbProgress = std::function<void(int tasks_done, int tasks_total, std::int64_t samples_done, double seconds)>;
 
 /// Checks the options and finds the grid. The automatic voxel size is the smallest of the form
-/// d x 10^e (d with 2 significant digits) at least cbrt(volume / target_active_voxels), and at
-/// least cbrt(box volume / max_dense_voxels) so the dense box stays within the limit.
+/// d x 10^e (d with 2 significant digits) at least cbrt(volume / target_active_voxels), at
+/// least cbrt(box volume / max_dense_voxels) so the dense box stays within the limit, and large
+/// enough that the estimated memory stays within max_memory_bytes.
 /// @throws Error (bad_input) for a model without cells, a voxel size that is not positive and
-///         finite, a supersample outside 1..8, a dense box beyond max_dense_voxels (unless force)
+///         finite, a supersample outside 1..8, a dense box beyond max_dense_voxels (unless force),
+///         a voxel_mm whose estimated memory exceeds max_memory_bytes (force does not lift it:
+///         raise max_memory_bytes), a max_memory_bytes too small for any voxel
 ///         or beyond 2^30 voxels along an axis (with the supersample), a layer range that is
 ///         not made of whole 8-layer blocks of the grid
 VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& options);
