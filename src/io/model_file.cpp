@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -164,24 +165,6 @@ vmodel::VModel read_model(std::string_view text, const std::string& source, cons
   return m;
 }
 
-std::string read_file(const fs::path& path) {
-  const std::string name = path.string();
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (!fs::exists(st))
-    throw Error(name + ": no such file; expected an existing model file (.json or G+Smo .xml)");
-  if (fs::is_directory(st))
-    throw Error(name + ": is a folder; expected a model file (.json or G+Smo .xml)");
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw Error(name + ": cannot open: " + system_reason(errno) + "; expected a readable file");
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad() || bytes.bad())
-    throw Error(name + ": cannot read: " + system_reason(errno) + "; expected a readable file");
-  return std::move(bytes).str();
-}
-
 std::string read_file(const fs::path& path, const Limits& limits) {
   const std::string name = path.string();
   std::error_code ec;
@@ -213,6 +196,12 @@ std::string read_file(const fs::path& path, const Limits& limits) {
     bytes.append(chunk, static_cast<std::size_t>(n));
   }
   return bytes;
+}
+
+std::string read_file(const fs::path& path) {
+  Limits unbounded;  // outputs read back (manifests, VDB parts): no input-size limit of their own
+  unbounded.max_file_bytes = std::numeric_limits<std::int64_t>::max();
+  return read_file(path, unbounded);
 }
 
 vmodel::VModel load_model(const fs::path& path, const Limits& limits) {

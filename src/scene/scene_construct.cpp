@@ -81,7 +81,7 @@ void load_gismo(const Source& src, const json& item, const std::string& ptr, Sce
   const std::filesystem::path path = std::filesystem::path(src.name).parent_path() / r.file;
   vmodel::VModel file;
   try {
-    file = io::read_gismo_xml(io::read_file(path), path.string());
+    file = io::read_gismo_xml(io::read_file(path, default_limits()), path.string());
   } catch (const Error& e) {
     throw e.within(src.at(gp));
   }

@@ -48,7 +48,8 @@ vmodel::VModel load_model(const std::filesystem::path& path, const Limits& limit
 ///         the model cannot be written (see write_model_json) or the folder is not writable
 void save_model(const vmodel::VModel& model, const std::filesystem::path& path);
 
-/// The whole content of a file, as bytes.
+/// The whole content of a file, as bytes, without a size limit: for files trivox wrote and reads
+/// back (manifests, VDB parts); inputs from users go through the overload with Limits.
 /// @throws trivox::Error (bad_input) "<path>: no such file; expected ..." and similar
 std::string read_file(const std::filesystem::path& path);
 
