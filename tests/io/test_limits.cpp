@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "io_test_util.hpp"
 #include "../../src/io/model_scan.hpp"
@@ -38,7 +39,9 @@ json line_cell(int p, const std::string& name = "c") {
           {"trivariate", {{"orders", {p, 2, 2}}, {"knots", {ku, {0, 0, 1, 1}, {0, 0, 1, 1}}}, {"points", points}}}};
 }
 
-json model(json cells, json properties = json::array()) {
+/// A model of the given cells. A vector, not a json parameter: a braced list of one json object
+/// initialises a json as a copy of that object with clang and as a one-element array with gcc.
+json model(const std::vector<json>& cells, json properties = json::array()) {
   return {{"trivox", 1}, {"units", "mm"}, {"properties", properties}, {"cells", cells}};
 }
 
