@@ -243,7 +243,19 @@ std::string palette_json(const Palette& palette) {
   out += "  ],\n";
   const auto d = static_cast<std::size_t>(palette.default_material);
   out += "  \"default\": " + s(d < palette.materials.size() ? palette.materials[d].name : std::string()) + ",\n";
+  // "rgb_materials" must name materials of the palette. A palette read without the key keeps the
+  // default Vero names, which need not be among its materials (they are checked when used); the
+  // key is then left out, and reading the file gives the same defaults back.
   const ColourMaterials& c = palette.rgb_materials;
+  const bool named = palette.find(c.cyan) >= 0 && palette.find(c.magenta) >= 0 && palette.find(c.yellow) >= 0 &&
+                     palette.find(c.black) >= 0 && palette.find(c.white) >= 0;
+  if (!named && !(c == ColourMaterials{}))
+    throw Error("cannot write the palette: rgb_materials names a material the palette does not have; expected the "
+                "names of palette materials, or the defaults");
+  if (!named) {
+    out.erase(out.size() - 2);  // the last ",\n"
+    return out + "\n}\n";
+  }
   out += "  \"rgb_materials\": {\"cyan\": " + s(c.cyan) + ", \"magenta\": " + s(c.magenta) + ", \"yellow\": " +
          s(c.yellow) + ", \"black\": " + s(c.black) + ", \"white\": " + s(c.white) + "}\n}\n";
   return out;

@@ -90,6 +90,15 @@ TEST_CASE("palette files: the shipped default equals default_palette, and files 
     const Palette p = load_palette(entry.path());
     CHECK(parse_palette(palette_json(p), "x") == p);
   }
+  // Without "rgb_materials" the palette keeps the default Vero names, none of which it has: the
+  // file written leaves the key out rather than name materials the palette lacks.
+  const Palette own = parse_palette(valid_palette().dump(), "p.json");
+  REQUIRE(own.find(ColourMaterials{}.cyan) == -1);
+  CHECK(parse_palette(palette_json(own), "x") == own);
+  CHECK(palette_json(own).find("rgb_materials") == std::string::npos);
+  Palette odd = own;
+  odd.rgb_materials.white = "nothing";
+  CHECK_THROWS_AS(palette_json(odd), trivox::Error);
 }
 
 TEST_CASE("palette parsing: optional fields and defaults", "[material]") {

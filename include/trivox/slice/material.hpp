@@ -89,7 +89,9 @@ Palette parse_palette(std::string_view json_text, const std::string& source);
 Palette load_palette(const std::filesystem::path& file);
 
 /// The palette as a palette file (parse_palette(palette_json(p), s) == p), two-space indented,
-/// one material per line, ending with a newline.
+/// one material per line, ending with a newline. "rgb_materials" is written when it names
+/// materials of the palette and left out when it holds the defaults that the palette lacks.
+/// @throws trivox::Error when rgb_materials names a material the palette lacks and is not the default
 std::string palette_json(const Palette& palette);
 
 /// Maps a model's per-voxel properties to palette material fractions (see the file comment).
