@@ -17,6 +17,7 @@
 #include "trivox/io/sha256.hpp"
 #include "trivox/job/slice_job.hpp"
 #include "trivox/job/vdb_job.hpp"
+#include "trivox/byte_size.hpp"
 #include "trivox/version.hpp"
 
 namespace trivox::cli {
@@ -31,7 +32,9 @@ struct Options {
   int digits = 0;
   std::string background = "transparent";
   double max_voxels = 1e11;  // a double, so that 1e9 reads as the help writes it
+  double max_layers = 1e5;
   std::string max_memory = "2G";
+  bool dry_run = false;
   bool png = false, vdb = false;
   double vdb_voxel = 0.0;
   std::string vdb_units = "mm", vdb_color_space = "linear";
@@ -114,15 +117,6 @@ job::SliceProgress make_progress(const std::string& mode, const char* unit = "la
   };
 }
 
-std::string human_bytes(double b) {
-  const char* units[] = {"B", "KB", "MB", "GB", "TB"};
-  int u = 0;
-  while (b >= 1000.0 && u < 4) b /= 1000.0, ++u;
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g %s", b, units[u]);
-  return buf;
-}
-
 nlohmann::ordered_json vdb_json(const job::VdbJobSummary& v) {
   nlohmann::ordered_json mats = nlohmann::ordered_json::array();
   for (std::size_t m = 0; m < v.materials.size(); ++m)
@@ -155,7 +149,7 @@ void print_vdb(const job::VdbJobSummary& v) {
   std::string grids;
   for (const auto& g : v.grids) grids += (grids.empty() ? "" : ", ") + g;
   std::printf("vdb: %s: %zu grids (%s), %s\n", v.file.string().c_str(), v.grids.size(), grids.c_str(),
-              human_bytes(static_cast<double>(v.bytes)).c_str());
+              file_size_text(static_cast<double>(v.bytes)).c_str());
   if (p.automatic)
     std::printf("voxel %s mm (automatic: volume %s mm^3 / voxel^3 = about %.3g active voxels, below %.3g and within the memory), supersample %d\n",
                 fmt(p.voxel_mm, 6).c_str(), fmt(p.estimated_volume_mm3, 8).c_str(), p.estimated_active_voxels, 5e7,
@@ -164,7 +158,7 @@ void print_vdb(const job::VdbJobSummary& v) {
     std::printf("voxel %s mm (--vdb-voxel), supersample %d\n", fmt(p.voxel_mm, 6).c_str(), p.supersample);
   std::printf("box %d x %d x %d voxels from (%s, %s, %s) mm; time %s; memory estimated %s (--max-memory)\n", p.count[0],
               p.count[1], p.count[2], fmt(p.origin[0], 6).c_str(), fmt(p.origin[1], 6).c_str(), fmt(p.origin[2], 6).c_str(),
-              duration(v.seconds).c_str(), human_bytes(p.estimated_memory_bytes).c_str());
+              duration(v.seconds).c_str(), memory_size_text(p.estimated_memory_bytes).c_str());
   std::printf("active voxels %lld (%lld fractional), volume %s mm^3 (quadrature %s mm^3)\n",
               static_cast<long long>(v.active_voxels), static_cast<long long>(v.fractional_voxels),
               fmt(v.volume_mm3, 8).c_str(), fmt(p.estimated_volume_mm3, 8).c_str());
@@ -176,6 +170,70 @@ void print_vdb(const job::VdbJobSummary& v) {
     if (v.material_volume_mm3[m] > 0)
       std::printf("  %-16s %14.3f mm^3\n", v.materials[m].c_str(), v.material_volume_mm3[m]);
   std::printf("inversion failures: %lld\n", static_cast<long long>(v.inversion_failures));
+}
+
+/// `--dry-run`: what the job would write and cost, nothing written.
+void print_dry_run(bool json, const std::string& model, const std::string& out, const job::SliceJobSummary* png,
+                   const std::optional<job::VdbJobSummary>& vdb, std::int64_t max_memory) {
+  nlohmann::ordered_json j = {{"model", model}, {"output", out}, {"dry_run", true}, {"max_memory_bytes", max_memory}};
+  if (png) {
+    const auto& e = png->estimate;
+    j["png"] = {{"grid", png->grid.count},
+                {"layers", e.layers},
+                {"layer_range", png->layer_range},
+                {"files", e.files},
+                {"voxels", e.voxels},
+                {"threads", e.threads},
+                {"grouped", e.grouped},
+                {"estimated_seconds", e.seconds},
+                {"estimated_memory_bytes", e.memory_bytes},
+                {"memory_held_bytes", e.base_bytes},
+                {"estimated_output_bytes", e.output_bytes},
+                {"timed_layers", e.timed_layers},
+                {"seconds_per_layer", e.seconds_per_layer}};
+  }
+  if (vdb) {
+    const auto& p = vdb->plan;
+    j["vdb"] = {{"file", vdb->file.string()},
+                {"voxel_mm", p.voxel_mm},
+                {"automatic", p.automatic},
+                {"supersample", p.supersample},
+                {"box", p.count},
+                {"estimated_active_voxels", p.estimated_active_voxels},
+                {"estimated_seconds", vdb->estimated_seconds},
+                {"estimated_memory_bytes", p.estimated_memory_bytes},
+                {"estimated_output_bytes", p.estimated_active_voxels * p.grids_values * 4.0},
+                {"tasks", vdb->tasks},
+                {"timed_tasks", vdb->timed_tasks}};
+  }
+  if (json) {
+    print_json(j);
+    return;
+  }
+  std::printf("dry run of %s -> %s: nothing written\n", model.c_str(), out.c_str());
+  if (png) {
+    const auto& e = png->estimate;
+    const auto& c = png->grid.count;
+    std::printf("png: %d x %d pixels x %d layers; %d files (slices%s), %lld voxels\n", c[0], c[1], e.layers, e.files,
+                png->shard.count == 1 ? ", ConfigFile.xml, manifest.json" : ", the shard's manifest",
+                static_cast<long long>(e.voxels));
+    std::printf("  time about %s on %d worker%s (%.3g s of CPU a layer, from %d layers); slices about %s\n",
+                duration(e.seconds).c_str(), e.threads, e.threads == 1 ? "" : "s", e.seconds_per_layer, e.timed_layers,
+                file_size_text(e.output_bytes).c_str());
+    std::printf("  memory about %s (%s held before the job; --max-memory %s)%s\n", memory_size_text(e.memory_bytes).c_str(),
+                memory_size_text(e.base_bytes).c_str(), memory_size_text(static_cast<double>(max_memory)).c_str(),
+                e.grouped ? "; layers dithered 8 at a time" : "");
+  }
+  if (vdb) {
+    const auto& p = vdb->plan;
+    std::printf("vdb: %s: voxel %s mm%s, box %d x %d x %d, about %.3g active voxels\n", vdb->file.string().c_str(),
+                fmt(p.voxel_mm, 6).c_str(), p.automatic ? " (automatic)" : "", p.count[0], p.count[1], p.count[2],
+                p.estimated_active_voxels);
+    std::printf("  time about %s (from %d of %d tasks); memory about %s (--max-memory %s); file about %s before compression\n",
+                duration(vdb->estimated_seconds).c_str(), vdb->timed_tasks, vdb->tasks,
+                memory_size_text(p.estimated_memory_bytes).c_str(), memory_size_text(static_cast<double>(max_memory)).c_str(),
+                file_size_text(p.estimated_active_voxels * p.grids_values * 4.0).c_str());
+  }
 }
 
 }  // namespace
@@ -197,10 +255,15 @@ void add_slice(CLI::App& app, Common& common) {
                   "Zero-pad slice numbers to N digits (default 0: slice_0.png, as Voxel Print tools name them)");
   sub->add_option("--background", opt->background,
                   "Void pixels: transparent (0 0 0 0, default) or black (0 0 0 255); declared in ConfigFile.xml");
-  sub->add_flag("--force", opt->force, "Write into a non-empty folder; allow jobs beyond the tray or --max-voxels");
-  sub->add_option("--max-voxels", opt->max_voxels, "Refuse larger grids unless --force (default 1e11)");
+  sub->add_flag("--force", opt->force,
+                "Write into a non-empty folder (removing only what trivox wrote there); allow models beyond the tray");
+  sub->add_option("--max-voxels", opt->max_voxels, "Refuse PNG jobs of more voxels (default 1e11)");
+  sub->add_option("--max-layers", opt->max_layers, "Refuse PNG jobs of more layers, a file each (default 1e5)");
   sub->add_option("--max-memory", opt->max_memory,
-                  "Memory the VDB job may use: its automatic voxel fits, a finer --vdb-voxel is refused (default 2G)");
+                  "Memory a job may use (default 2G): the PNG job runs as many workers as fit, the VDB's automatic "
+                  "voxel fits, a finer --vdb-voxel is refused");
+  sub->add_flag("--dry-run", opt->dry_run,
+                "Check everything, estimate the time, memory and output size from a few layers, write nothing");
   sub->add_option("--threads", opt->threads, "Worker threads (default: all cores)");
   sub->add_option("--progress", opt->progress, "auto (bar on a terminal, lines otherwise), bar, lines, never");
   sub->add_flag("--png", opt->png, "Write the PNG stack (the default without --vdb)");
@@ -218,16 +281,22 @@ void add_slice(CLI::App& app, Common& common) {
   sub->callback([opt, &common, sub] {
     const bool want_vdb = opt->vdb, want_png = opt->png || !opt->vdb;
     if (!want_vdb)
-      for (const char* o : {"--vdb-voxel", "--vdb-units", "--vdb-color-space", "--supersample", "--max-memory"})
+      for (const char* o : {"--vdb-voxel", "--vdb-units", "--vdb-color-space", "--supersample"})
         if (sub->count(o) > 0) throw Error(std::string(o) + ": applies to the VDB output; expected --vdb with it");
     if (!want_png)
-      for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels", "--digits", "--background"})
+      for (const char* o : {"--printer", "--dpi", "--layer", "--dither", "--zip", "--max-voxels", "--max-layers", "--digits", "--background"})
         if (sub->count(o) > 0)
           throw Error(std::string(o) + ": applies to the PNG stack; expected --png with it (--vdb alone writes only the VDB)");
     if (opt->progress != "auto" && opt->progress != "bar" && opt->progress != "lines" && opt->progress != "never")
       throw Error("--progress " + opt->progress + ": unknown mode; expected auto, bar, lines or never");
     if (!(opt->max_voxels >= 1 && opt->max_voxels <= 1e18 && std::floor(opt->max_voxels) == opt->max_voxels))
       throw Error("--max-voxels " + fmt(opt->max_voxels) + ": out of range; expected a whole number of voxels, 1 to 1e18");
+    if (!(opt->max_layers >= 1 && opt->max_layers <= 1e9 && std::floor(opt->max_layers) == opt->max_layers))
+      throw Error("--max-layers " + fmt(opt->max_layers) + ": out of range; expected a whole number of layers, 1 to 1e9");
+    if (opt->dry_run && (opt->resume || opt->force))
+      throw Error(std::string(opt->resume ? "--resume" : "--force") +
+                  ": with --dry-run, which writes nothing and does not look at the folder; expected one or the other");
+    const std::int64_t max_memory = parse_bytes(opt->max_memory, "--max-memory");
     if (opt->threads < 0 || opt->threads > 1024)
       throw Error("--threads " + std::to_string(opt->threads) + ": out of range; expected 1 to 1024 (0: all cores)");
     // The shard: --shard wins over a scheduler's environment (Slurm arrays, Kubernetes).
@@ -255,7 +324,8 @@ void add_slice(CLI::App& app, Common& common) {
       if (!opt->palette.empty()) vj.palette = opt->palette;
       if (sub->count("--vdb-voxel") > 0) vj.voxel_mm = opt->vdb_voxel;
       vj.supersample = opt->supersample;
-      vj.max_memory_bytes = parse_bytes(opt->max_memory, "--max-memory");
+      vj.max_memory_bytes = max_memory;
+      vj.dry_run = opt->dry_run;
       vj.force = opt->force;
       vj.require_empty_folder = !want_png;
       plan = job::plan_vdb_job(model, vj);  // bad VDB options fail before the PNG stack is written
@@ -300,6 +370,11 @@ void add_slice(CLI::App& app, Common& common) {
               return f;
       return std::nullopt;
     };
+    if (opt->dry_run) vj.require_empty_folder = false;  // the folder is not looked at
+    if (!want_png && opt->dry_run) {
+      print_dry_run(common.json, opt->model, opt->out, nullptr, job::run_vdb_job(model, vj), max_memory);
+      return;
+    }
     if (!want_png) {
       // A volume-only job: its manifest lists the VDB (a shard's: its part of whole leaves).
       job::Manifest id;
@@ -373,10 +448,20 @@ void add_slice(CLI::App& app, Common& common) {
     job.extra_options = vdb_options;
     job.last_output = !want_vdb;  // the VDB follows and completes the manifest
     job.max_voxels = static_cast<std::int64_t>(opt->max_voxels);
+    job.max_layers = static_cast<std::int64_t>(opt->max_layers);
+    job.max_memory_bytes = max_memory;
+    job.dry_run = opt->dry_run;
     job.resume = opt->resume;
     job.shard = shard;
     job.sampler = sampling;
     if (plan) job.model_box = plan->model_box;
+    if (opt->dry_run) {
+      const auto s = job::run_slice_job(model, job);
+      std::optional<job::VdbJobSummary> v;
+      if (want_vdb) v = job::run_vdb_job(model, vj);
+      print_dry_run(common.json, opt->model, opt->out, &s, v, max_memory);
+      return;
+    }
     const std::optional<job::ManifestFile> vdb_done = verified_vdb();
     const auto s = job::run_slice_job(model, job, make_progress(opt->progress));
     std::optional<job::VdbJobSummary> v;

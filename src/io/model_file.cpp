@@ -232,6 +232,16 @@ void write_file_atomically(const fs::path& path, std::string_view bytes, Durabil
   if (sync) sync_folder(path);
 }
 
+void append_synced(const fs::path& path, std::string_view bytes) {
+  Fd fd(::open(path.c_str(), O_WRONLY | O_APPEND | O_NOFOLLOW | O_CLOEXEC));
+  if (fd.get() < 0) {
+    if (errno == ELOOP) throw Error(path.string() + ": is a symbolic link; expected the job's own journal");
+    write_failed(path, {}, errno);
+  }
+  if (!write_all(fd.get(), bytes) || ::fdatasync(fd.get()) != 0) write_failed(path, {}, errno);
+  if (fd.close() != 0) write_failed(path, {}, errno);
+}
+
 void save_model(const vmodel::VModel& model, const fs::path& path) {
   if (path.extension() == ".xml")
     throw Error(path.string() +

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "../detail/json_text.hpp"
@@ -12,6 +13,7 @@
 #include "trivox/io/gcvf.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/safe_path.hpp"
+#include "trivox/io/sha256.hpp"
 
 namespace trivox::job {
 
@@ -21,6 +23,7 @@ using ojson = nlohmann::ordered_json;
 using json = nlohmann::json;
 
 constexpr int manifest_version = 1;
+constexpr int journal_version = 1;
 constexpr int max_shards = 100000;
 /// A manifest takes about 250 bytes per layer: 256 MiB holds a million layers.
 constexpr std::int64_t max_manifest_bytes = std::int64_t{256} << 20;
@@ -81,12 +84,41 @@ bool is_slice_name(const std::string& name, int index) {
   return std::stoll(digits) == index;
 }
 
+/// One layer of manifest `m` (its range, file name and material count) at `p`; after `previous`
+/// (in a manifest's ascending list) when given.
+ManifestLayer parse_layer(const Reader& r, const json& l, const std::string& p, const Manifest& m,
+                          const ManifestLayer* previous = nullptr) {
+  if (!l.is_object()) r.fail_type(p, l, "an object {\"index\", \"file\", \"sha256\", \"voxels\", \"failures\"}");
+  ManifestLayer ml;
+  ml.index = static_cast<int>(r.integer(r.member(l, p, "index"), p + "/index", m.layer_range[0], m.layer_range[1] - 1));
+  if (previous && ml.index <= previous->index) r.fail_type(p + "/index", l["index"], "layers in ascending order, each once");
+  ml.file = r.string(r.member(l, p, "file"), p + "/file");
+  if (!io::plain_file_name(ml.file)) r.fail_type(p + "/file", l["file"], "a file name inside the folder");
+  if (!is_slice_name(ml.file, ml.index))
+    r.fail_type(p + "/file", l["file"], "slice_" + std::to_string(ml.index) + ".png (zero-padded or not), the name of layer " +
+                                            std::to_string(ml.index));
+  ml.sha256 = r.sha(r.member(l, p, "sha256"), p + "/sha256");
+  const auto& vox = r.array(r.member(l, p, "voxels"), p + "/voxels", "voxel counts");
+  if (vox.size() != m.materials.size())
+    r.fail_type(p + "/voxels", vox, "one count per material (" + std::to_string(m.materials.size()) + ")");
+  for (std::size_t k = 0; k < vox.size(); ++k)
+    ml.voxels.push_back(r.integer(vox[k], p + "/voxels/" + std::to_string(k), 0, std::int64_t{1} << 53));
+  ml.failures = r.integer(r.member(l, p, "failures"), p + "/failures", 0, std::int64_t{1} << 53);
+  return ml;
+}
+
+ojson layer_json(const ManifestLayer& l) {
+  return {{"index", l.index}, {"file", l.file}, {"sha256", l.sha256}, {"voxels", l.voxels}, {"failures", l.failures}};
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------------------------------
 // Shards
 
 std::string Shard::manifest_name() const { return part_name("manifest.json"); }
+
+std::string Shard::journal_name() const { return part_name("manifest.journal"); }
 
 std::string Shard::part_name(const std::string& name) const {
   if (count == 1) return name;
@@ -240,8 +272,7 @@ std::string manifest_json(const Manifest& m) {
   for (const auto& f : m.files) files.push_back({{"role", f.role}, {"file", f.file}, {"sha256", f.sha256}});
   j["files"] = files;
   ojson layers = ojson::array();
-  for (const auto& l : m.layers)
-    layers.push_back({{"index", l.index}, {"file", l.file}, {"sha256", l.sha256}, {"voxels", l.voxels}, {"failures", l.failures}});
+  for (const auto& l : m.layers) layers.push_back(layer_json(l));
   j["layers"] = layers;
   std::string text = j.dump(2);
   text += '\n';
@@ -344,35 +375,82 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
   }
   const auto& layers = r.array(r.member(root, "", "layers"), "/layers", "layers");
   for (std::size_t i = 0; i < layers.size(); ++i) {
-    const std::string p = "/layers/" + std::to_string(i);
-    const json& l = layers[i];
-    if (!l.is_object()) r.fail_type(p, l, "an object {\"index\", \"file\", \"sha256\", \"voxels\", \"failures\"}");
-    ManifestLayer ml;
-    ml.index = static_cast<int>(r.integer(r.member(l, p, "index"), p + "/index", m.layer_range[0], m.layer_range[1] - 1));
-    if (!m.layers.empty() && ml.index <= m.layers.back().index)
-      r.fail_type(p + "/index", l["index"], "layers in ascending order, each once");
-    ml.file = r.string(r.member(l, p, "file"), p + "/file");
-    if (!io::plain_file_name(ml.file)) r.fail_type(p + "/file", l["file"], "a file name inside the folder");
-    if (!is_slice_name(ml.file, ml.index))
-      r.fail_type(p + "/file", l["file"], "slice_" + std::to_string(ml.index) + ".png (zero-padded or not), the name of layer " +
-                                              std::to_string(ml.index));
-    ml.sha256 = r.sha(r.member(l, p, "sha256"), p + "/sha256");
-    const auto& vox = r.array(r.member(l, p, "voxels"), p + "/voxels", "voxel counts");
-    if (vox.size() != m.materials.size())
-      r.fail_type(p + "/voxels", vox, "one count per material (" + std::to_string(m.materials.size()) + ")");
-    for (std::size_t k = 0; k < vox.size(); ++k)
-      ml.voxels.push_back(r.integer(vox[k], p + "/voxels/" + std::to_string(k), 0, std::int64_t{1} << 53));
-    ml.failures = r.integer(r.member(l, p, "failures"), p + "/failures", 0, std::int64_t{1} << 53);
+    ManifestLayer ml = parse_layer(r, layers[i], "/layers/" + std::to_string(i), m, m.layers.empty() ? nullptr : &m.layers.back());
     m.layers.push_back(std::move(ml));
   }
   return m;
+}
+
+std::string journal_name_of(const std::string& manifest_name) {
+  const std::string stem = manifest_name.ends_with(".json") ? manifest_name.substr(0, manifest_name.size() - 5) : manifest_name;
+  return stem + ".journal";
+}
+
+std::string journal_header(std::string_view manifest_text) {
+  ojson j;
+  j["trivox_journal"] = journal_version;
+  j["manifest_sha256"] = io::sha256_hex(manifest_text);
+  return j.dump() + '\n';
+}
+
+std::string journal_line(const ManifestLayer& layer) { return layer_json(layer).dump() + '\n'; }
+
+std::size_t apply_journal(Manifest& m, std::string_view manifest_text, std::string_view journal_text) {
+  if (m.complete) return 0;
+  const std::string source = "journal";
+  const Reader r{source};
+  std::map<int, ManifestLayer> added;
+  bool header = false;
+  // Only whole lines: a last line without its newline was cut short.
+  for (std::size_t at = 0, end; (end = journal_text.find('\n', at)) != std::string_view::npos; at = end + 1) {
+    const std::string_view line = journal_text.substr(at, end - at);
+    json j;
+    try {
+      j = json::parse(line);
+    } catch (const json::exception&) {
+      break;
+    }
+    if (!header) {
+      const auto v = j.is_object() ? j.find("trivox_journal") : j.end();
+      const auto d = j.is_object() ? j.find("manifest_sha256") : j.end();
+      if (v == j.end() || d == j.end() || *v != journal_version || !d->is_string() ||
+          d->get<std::string>() != io::sha256_hex(manifest_text))
+        return 0;
+      header = true;
+      continue;
+    }
+    try {
+      ManifestLayer l = parse_layer(r, j, "", m);
+      added[l.index] = std::move(l);
+    } catch (const Error&) {
+      break;
+    }
+  }
+  const std::size_t from_journal = added.size();
+  if (from_journal == 0) return 0;
+  for (ManifestLayer& l : m.layers) added.try_emplace(l.index, std::move(l));
+  m.layers.clear();
+  m.layers.reserve(added.size());
+  for (auto& [k, l] : added) m.layers.push_back(std::move(l));
+  return from_journal;
 }
 
 std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name) {
   const auto path = dir / name;
   const std::optional<std::string> text = io::read_regular_file(path, max_manifest_bytes);
   if (!text) return std::nullopt;
-  return parse_manifest(*text, path.string());
+  Manifest m = parse_manifest(*text, path.string());
+  if (!m.complete) {
+    // A journal that cannot be read (a link, a folder, too large) adds nothing: its layers are
+    // redone.
+    std::optional<std::string> journal;
+    try {
+      journal = io::read_regular_file(dir / journal_name_of(name), max_manifest_bytes);
+    } catch (const Error&) {
+    }
+    if (journal) apply_journal(m, *text, *journal);
+  }
+  return m;
 }
 
 std::string vdb_file_name(const Manifest& m) {

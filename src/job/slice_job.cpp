@@ -1,6 +1,7 @@
 #include "trivox/job/slice_job.hpp"
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
@@ -18,10 +19,12 @@
 #include <map>
 #include <optional>
 #include <system_error>
-#include <time.h>
+#include <unistd.h>
 
 #include "../io/png_codec.hpp"
 #include "../io/png_rows.hpp"
+#include "thread_time.hpp"
+#include "trivox/byte_size.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/safe_path.hpp"
@@ -40,14 +43,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string human_bytes(double b) {
-  const char* units[] = {"B", "KB", "MB", "GB", "TB", "PB"};
-  int u = 0;
-  while (b >= 1000.0 && u < 5) b /= 1000.0, ++u;
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g %s", b, units[u]);
-  return buf;
-}
+using detail::thread_cpu_seconds;
+
+/// The memory estimate's size of an encoded slice in flight (SliceJobEstimate::memory_bytes).
+constexpr double encoded_bytes_per_pixel = 0.5;
+/// And what a job holds whatever its layers: the threads' stacks, the encoder's and the
+/// pipeline's state (15 to 19 MB measured beyond the buffers on small layers).
+constexpr double fixed_job_bytes = 32.0 * 1024 * 1024;
+
 
 /// A number as a user would type it: 0.027, not 0.027000.
 std::string text(double v) {
@@ -86,6 +89,11 @@ bool is_manifest_name(const std::string& name) {
   return name == "manifest.json" || (name.starts_with("manifest.shard-") && name.ends_with(".json"));
 }
 
+/// A manifest's journal (manifest.hpp, journal_name_of).
+bool is_journal_name(const std::string& name) {
+  return name == "manifest.journal" || (name.starts_with("manifest.shard-") && name.ends_with(".journal"));
+}
+
 /// Per-worker scratch, reused across layers so a job allocates once per thread.
 struct Scratch {
   slice::RowBand band;
@@ -101,12 +109,14 @@ struct Scratch {
 
 using Clock = std::chrono::steady_clock;
 
-/// This thread's CPU time in seconds: stage figures that a busy machine does not inflate with
-/// the time a worker waits for a core (wall-clock laps did).
-inline double thread_cpu_seconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+/// What the process holds in memory now (resident pages, /proc/self/statm); 0 where unknown.
+double resident_bytes() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (f == nullptr) return 0.0;
+  long long size = 0, resident = 0;
+  const int n = std::fscanf(f, "%lld %lld", &size, &resident);
+  std::fclose(f);
+  return n == 2 ? static_cast<double>(resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) : 0.0;
 }
 
 /// Adds this thread's CPU time since `t` to `acc` and moves `t` to now.
@@ -161,12 +171,15 @@ std::optional<long long> slice_number(const std::string& name) {
 }
 
 /// Whether `name` is one of the outputs of job `id` (this shard's, for a shard): its slices, its
-/// manifest, ConfigFile.xml and the VDB of a whole job, its own VDB part and write probe.
+/// manifest and journal, ConfigFile.xml and the VDB of a whole job, its own VDB part and write
+/// probe.
 bool job_output_name(const Manifest& id, const std::string& name) {
   const bool whole = id.shard.count == 1;
   if (const auto n = slice_number(name)) return whole || (*n >= id.layer_range[0] && *n < id.layer_range[1]);
-  if (whole) return is_manifest_name(name) || name == "ConfigFile.xml" || name == vdb_file_name(id) || name.starts_with(".trivox-write-test");
-  return name == id.shard.manifest_name() || name == id.shard.part_name(vdb_file_name(id)) ||
+  if (whole)
+    return is_manifest_name(name) || is_journal_name(name) || name == "ConfigFile.xml" || name == vdb_file_name(id) ||
+           name.starts_with(".trivox-write-test");
+  return name == id.shard.manifest_name() || name == id.shard.journal_name() || name == id.shard.part_name(vdb_file_name(id)) ||
          name == ".trivox-write-test-" + std::to_string(id.shard.index);
 }
 
@@ -224,7 +237,10 @@ void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vecto
   if (!png || last)
     for (const auto& [n, name] : io::detail::list_slices(dir, io::StackConfig{}.prefix))
       if (!png || n >= id.layer_range[1]) remove(dir / name);
-  for (const auto& [name, m] : stale) remove(dir / name);
+  for (const auto& [name, m] : stale) {
+    remove(dir / journal_name_of(name));
+    remove(dir / name);
+  }
 }
 
 }  // namespace
@@ -346,7 +362,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   const double bytes = static_cast<double>(grid.voxels()) * 4.0;
   const std::string estimate = std::to_string(grid.count[0]) + " x " + std::to_string(grid.count[1]) + " x " +
                                std::to_string(grid.count[2]) + " = " + std::to_string(grid.voxels()) + " voxels, " +
-                               human_bytes(bytes) + " of RGBA pixels before compression";
+                               file_size_text(bytes) + " of RGBA pixels before compression";
   if (!opt.force) {
     static constexpr const char* axis = "xyz";
     for (int d = 0; d < 3; ++d) {
@@ -356,10 +372,16 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
                     ", larger than the " + opt.profile.name + " tray (" + text(opt.profile.tray_mm[dd]) +
                     " mm); expected a model that fits (or --force). Job: " + estimate);
     }
-    if (grid.voxels() > opt.max_voxels)
-      throw Error(opt.model_name + ": the job has " + estimate + "; expected at most " + std::to_string(opt.max_voxels) +
-                  " voxels (raise --max-voxels or use --force)");
   }
+  // The output's size: limits that --force does not lift (it is for folders and trays).
+  if (grid.voxels() > opt.max_voxels)
+    throw Error(opt.model_name + ": the job has " + estimate + "; expected at most " + std::to_string(opt.max_voxels) +
+                " voxels (limit --max-voxels; raise it with --max-voxels N)");
+  if (grid.count[2] > opt.max_layers)
+    throw Error(opt.model_name + ": the job has " + std::to_string(grid.count[2]) + " layers (" +
+                text(box[1][2] - box[0][2]) + " mm in layers of " + text(opt.profile.layer_mm) +
+                " mm), a file each; expected at most " + std::to_string(opt.max_layers) +
+                " (limit --max-layers; raise it with --max-layers N, or a thicker --layer)");
 
   check_voxel_print_numbers(opt.profile);
   if (opt.digits < 0 || opt.digits > 9)
@@ -432,115 +454,60 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
   manifest.shard = opt.shard;
   manifest.layer_range = opt.shard.range(nz);
-  // The archive's place is checked before the slices are written, not after.
-  if (opt.zip) {
-    const fs::path zip = io::gcvf_path(opt.out_dir);
-    std::error_code ec;
-    if (fs::is_directory(zip, ec))
-      throw Error(zip.string() + ": is a folder; expected a .gcvf file path to write (--zip packs DIR as DIR.gcvf)");
-    // A non-empty folder without --force or --resume is refused below, with its own reason;
-    // shards' archive is merge's to write.
-    const bool fresh = !fs::exists(opt.out_dir, ec) || fs::is_empty(opt.out_dir, ec);
-    if (fs::exists(zip, ec) && fresh && !opt.force && !opt.resume && opt.shard.count == 1)
-      throw Error(zip.string() + ": exists; expected a new archive (--force to replace it, or another output folder)");
-  }
-  const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt.force, opt.resume);
   io::StackConfig cfg = stack_config_of(manifest, {});
 
-  std::map<int, ManifestLayer> finished;  // by layer
-  std::vector<int> todo;
-  {
-    std::vector<char> keep(static_cast<std::size_t>(nz), 0);
-    if (previous)
-      tbb::parallel_for(manifest.layer_range[0], manifest.layer_range[1], [&](int k) {
-        // A layer that is a symbolic link (to a file elsewhere, whose bytes may match) is redone:
-        // the finished job must not depend on a file outside the folder. Its rename then
-        // replaces the link itself.
-        const ManifestLayer* l = previous->layer(k);
-        const fs::path f = opt.out_dir / cfg.slice_name(k);
-        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && io::sha256_regular_file(f) == l->sha256;
-      });
-    for (int k = manifest.layer_range[0]; k < manifest.layer_range[1]; ++k)
-      if (keep[static_cast<std::size_t>(k)]) finished.emplace(k, *previous->layer(k));
-      else todo.push_back(k);
-  }
-  const int kept = static_cast<int>(finished.size());
-  const int total_layers = manifest.layer_range[1] - manifest.layer_range[0];
-
-  // The manifest lists only layers already on disk: sync first.
-  auto list_finished = [&](Manifest& m, bool complete) {
-    m.layers.clear();
-    for (const auto& [k, l] : finished) m.layers.push_back(l);
-    m.complete = complete;
-  };
-  auto sync_and_write = [](const fs::path& dir, const Manifest& m) {
-    // A manifest listing no layer (a new job's first) vouches for no file: no sync needed (it
-    // cost 3 ms here, a whole file system's dirty pages elsewhere).
-    if (!m.layers.empty()) io::sync_folder_contents(dir);
-    io::write_file_atomically(dir / m.shard.manifest_name(), manifest_json(m));
-  };
-  auto write_manifest = [&](bool complete) {
-    list_finished(manifest, complete);
-    sync_and_write(opt.out_dir, manifest);
-  };
-  write_manifest(false);
-  auto last_manifest = Clock::now();
-  // The periodic manifest: its sync (which waits for the disk, seconds on a network share) runs
-  // on a thread of its own, so that no worker waits for it. It lists the layers written before
-  // it was taken; one at a time (a period whose predecessor is still syncing is skipped).
-  // std::async's future waits in its destructor, so an exception leaves no thread behind.
-  std::future<void> pending_manifest;
-  // A job that stops on an error from here on (a full disk, a failing layer) first writes a last
-  // manifest listing the layers it finished, synced, so that --resume keeps them. Best effort:
-  // when that fails too (the disk is full), the original error is the one reported.
-  const OnUnwind last_words([&] {
-    if (pending_manifest.valid()) pending_manifest.wait();
-    write_manifest(false);
-  });
-  auto write_manifest_behind = [&] {
-    if (pending_manifest.valid()) {
-      if (pending_manifest.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
-      pending_manifest.get();  // rethrows its error
-    }
-    Manifest snapshot = manifest;
-    list_finished(snapshot, false);
-    pending_manifest = std::async(std::launch::async, [snapshot = std::move(snapshot), dir = opt.out_dir, sync_and_write] {
-      sync_and_write(dir, snapshot);
-    });
-    last_manifest = Clock::now();
-  };
-
   tbb::enumerable_thread_specific<Scratch> scratch;
-  int done = kept;
-  const int threads = static_cast<int>(tbb::this_task_arena::max_concurrency());
-  const int tokens = threads + 1;
+  // The workers available: the arena's, within a global limit (--threads).
+  const int cores = static_cast<int>(std::min<std::size_t>(
+      static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
 
   // Work items are groups of layers. On the colour path with fs, a group of up to 8 layers is
   // dithered together, one layer per vector lane (slice::LayerGroupDitherer: the same pixels as
   // one layer at a time, at a fraction of the cost), when each thread's group of index buffers
-  // (a byte per pixel) fits in group_budget / threads; otherwise every group is one layer. The groups split the
-  // layers to do into a multiple of the thread count of nearly equal sizes, so that no thread
-  // is left with a last group alone.
+  // (a byte per pixel) fits in group_budget / threads and the job's memory within
+  // max_memory_bytes; otherwise every group is one layer. The groups split the layers to do into
+  // a multiple of the thread count of nearly equal sizes, so that no thread is left with a last
+  // group alone.
   constexpr double group_budget = 1024.0 * 1024.0 * 1024.0;  // bytes of index layers in all groups
   const double layer_bytes = static_cast<double>(nx) * static_cast<double>(ny);
   // TRIVOX_LAYER_GROUP=N caps the group size (diagnostics and tests: the output is the same).
   int group_cap = slice::LayerGroupDitherer::max_layers;
   if (const char* env = std::getenv("TRIVOX_LAYER_GROUP"))
     group_cap = std::clamp(std::atoi(env), 1, slice::LayerGroupDitherer::max_layers);
-  const bool grouped = group_cap >= 3 && slice::LayerGroupDitherer::serves(mode, mapper) &&
-                       group_cap * layer_bytes * threads <= group_budget;
-  std::vector<std::vector<int>> groups;
-  {
-    const int n = static_cast<int>(todo.size()), g = grouped ? group_cap : 1;
-    int ng = (n + g - 1) / g;
-    if (grouped) ng = std::min(n, (ng + threads - 1) / threads * threads);
-    for (int i = 0, at = 0; i < ng; ++i) {
-      const int size = n / ng + (i < n % ng ? 1 : 0);
-      groups.emplace_back(todo.begin() + at, todo.begin() + at + size);
-      at += size;
-    }
-  }
-  std::size_t next = 0;
+  bool grouped = group_cap >= 3 && slice::LayerGroupDitherer::serves(mode, mapper) &&
+                 group_cap * layer_bytes * cores <= group_budget;
+
+  // Memory (SliceJobEstimate): what the process holds, and per worker its buffers and the
+  // encoded layers it has in flight, half a byte per pixel each (slices of a random-looking
+  // mix of 6 materials compress to about 0.4, solid parts to a few hundredths), and one more
+  // work item waiting for the writer. The workers are as many as fit in max_memory_bytes,
+  // ungrouped if need be: the output does not depend on their count.
+  const double base_bytes = resident_bytes();
+  const double band_bytes = static_cast<double>(band_rows) * nx * (4.0 + 4.0 * nprops);
+  auto worker_bytes = [&](bool group) {
+    const int g = group ? group_cap : 1;
+    const double buffers = group ? g * (layer_bytes + std::min(band_rows, 2 * slice::LayerSampler::block_rows) * nx * (4.0 + 4.0 * nprops))
+                                 : 4.0 * layer_bytes + band_bytes;
+    return buffers + g * encoded_bytes_per_pixel * layer_bytes;  // and its encoded layers
+  };
+  auto job_bytes = [&](int w, bool group) {
+    return base_bytes + fixed_job_bytes + w * worker_bytes(group) + (group ? group_cap : 1) * encoded_bytes_per_pixel * layer_bytes;
+  };
+  int threads = cores;
+  if (grouped && job_bytes(threads, true) > static_cast<double>(opt.max_memory_bytes)) grouped = false;
+  while (threads > 1 && job_bytes(threads, grouped) > static_cast<double>(opt.max_memory_bytes)) --threads;
+  if (job_bytes(threads, grouped) > static_cast<double>(opt.max_memory_bytes))
+    throw Error("--max-memory " + memory_size_text(static_cast<double>(opt.max_memory_bytes)) + ": the job needs about " +
+                memory_size_text(job_bytes(1, false)) + " with one worker (" + memory_size_text(base_bytes) + " held already, " +
+                std::to_string(nx) + " x " + std::to_string(ny) + " pixels a layer); expected a limit above it " +
+                "(raise --max-memory, or a coarser --dpi)");
+  const int tokens = threads + 1;
+  SliceJobEstimate est;
+  est.threads = threads;
+  est.grouped = grouped;
+  est.base_bytes = base_bytes;
+  est.memory_bytes = job_bytes(threads, grouped);
 
   // A layer's PNG, from its pixels (RGBA) or its material indices, and the PNG's digest.
   auto encode = [&](LayerOut& out, const std::uint8_t* pixels, bool indexed) {
@@ -643,7 +610,162 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     return outs;
   };
 
+  // The estimate's time and size: a few layers, evenly spread over the range, sampled, dithered
+  // and encoded in memory.
+  constexpr int probe_layers = 8;
+  const int range_layers = manifest.layer_range[1] - manifest.layer_range[0];
+  if (opt.dry_run) {
+    std::vector<int> probe;
+    for (int q = 0; q < probe_layers; ++q) {
+      const int k = manifest.layer_range[0] + static_cast<int>((static_cast<std::int64_t>(range_layers) * (2 * q + 1)) / (2 * probe_layers));
+      if (k < manifest.layer_range[1] && (probe.empty() || probe.back() != k)) probe.push_back(k);
+    }
+    std::vector<double> cpu(probe.size()), bytes(probe.size());
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      tbb::parallel_for(std::size_t{0}, probe.size(), [&](std::size_t i) {
+        const double c0 = thread_cpu_seconds();
+        bytes[i] = static_cast<double>(sample_layer(probe[i]).png.size());
+        cpu[i] = thread_cpu_seconds() - c0;
+      });
+    });
+    double cpu_sum = 0.0, bytes_sum = 0.0;
+    for (std::size_t i = 0; i < probe.size(); ++i) {
+      cpu_sum += cpu[i];
+      bytes_sum += bytes[i];
+    }
+    est.timed_layers = static_cast<int>(probe.size());
+    est.seconds_per_layer = probe.empty() ? 0.0 : cpu_sum / static_cast<double>(probe.size());
+    est.layers = range_layers;
+    est.seconds = est.seconds_per_layer * range_layers / threads;
+    est.output_bytes = probe.empty() ? 0.0 : bytes_sum / static_cast<double>(probe.size()) * range_layers;
+  }
+  if (opt.dry_run) {
+    est.voxels = static_cast<std::int64_t>(range_layers) * grid.voxels_per_layer();
+    est.files = range_layers + (opt.shard.count == 1 ? 2 : 1);
+    SliceJobSummary sum;
+    sum.grid = grid;
+    sum.dry_run = true;
+    sum.estimate = est;
+    sum.layer_range = manifest.layer_range;
+    sum.shard = opt.shard;
+    sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    for (const auto& mat : palette.materials) {
+      sum.materials.push_back(mat.name);
+      sum.colours.push_back(mat.rgba);
+    }
+    return sum;
+  }
+
+  // The archive's place is checked before the slices are written, not after.
+  if (opt.zip) {
+    const fs::path zip = io::gcvf_path(opt.out_dir);
+    std::error_code ec;
+    if (fs::is_directory(zip, ec))
+      throw Error(zip.string() + ": is a folder; expected a .gcvf file path to write (--zip packs DIR as DIR.gcvf)");
+    // A non-empty folder without --force or --resume is refused below, with its own reason;
+    // shards' archive is merge's to write.
+    const bool fresh = !fs::exists(opt.out_dir, ec) || fs::is_empty(opt.out_dir, ec);
+    if (fs::exists(zip, ec) && fresh && !opt.force && !opt.resume && opt.shard.count == 1)
+      throw Error(zip.string() + ": exists; expected a new archive (--force to replace it, or another output folder)");
+  }
+  const std::optional<Manifest> previous = prepare_job_folder(opt.out_dir, manifest, opt.force, opt.resume);
+
+  std::map<int, ManifestLayer> finished;  // by layer
+  std::vector<int> todo;
+  {
+    std::vector<char> keep(static_cast<std::size_t>(nz), 0);
+    if (previous)
+      tbb::parallel_for(manifest.layer_range[0], manifest.layer_range[1], [&](int k) {
+        // A layer that is a symbolic link (to a file elsewhere, whose bytes may match) is redone:
+        // the finished job must not depend on a file outside the folder. Its rename then
+        // replaces the link itself.
+        const ManifestLayer* l = previous->layer(k);
+        const fs::path f = opt.out_dir / cfg.slice_name(k);
+        keep[static_cast<std::size_t>(k)] = l && l->file == cfg.slice_name(k) && io::sha256_regular_file(f) == l->sha256;
+      });
+    for (int k = manifest.layer_range[0]; k < manifest.layer_range[1]; ++k)
+      if (keep[static_cast<std::size_t>(k)]) finished.emplace(k, *previous->layer(k));
+      else todo.push_back(k);
+  }
+  const int kept = static_cast<int>(finished.size());
+  const int total_layers = manifest.layer_range[1] - manifest.layer_range[0];
+
+  // The manifest is written whole twice: now, listing the layers kept, and at the end (or when
+  // the job stops on an error), listing every finished layer. Between them the layers finished
+  // are appended to its journal (apply_journal), a few seconds' worth at a time, so that keeping
+  // the record costs time linear in the layers. Both list only layers already on disk: the
+  // folder is synced first.
+  const fs::path journal = opt.out_dir / manifest.shard.journal_name();
+  auto write_manifest = [&](bool complete) {
+    manifest.layers.clear();
+    for (const auto& [k, l] : finished) manifest.layers.push_back(l);
+    manifest.complete = complete;
+    // A manifest listing no layer (a new job's first) vouches for no file: no sync needed (it
+    // cost 3 ms here, a whole file system's dirty pages elsewhere).
+    if (!manifest.layers.empty()) io::sync_folder_contents(opt.out_dir);
+    const std::string text = manifest_json(manifest);
+    io::write_file_atomically(opt.out_dir / manifest.shard.manifest_name(), text);
+    return text;
+  };
+  // The journal of the manifest just written; removed once a later manifest lists its layers
+  // (a journal left by a kill in between belongs to another manifest, so no reader takes it).
+  io::write_file_atomically(journal, journal_header(write_manifest(false)));
+  auto end_journal = [&] {
+    std::error_code ec;
+    fs::remove(journal, ec);
+  };
+  auto last_manifest = Clock::now();
+  std::vector<ManifestLayer> unjournaled;  // finished, not yet in the journal
+  // The journal's appends: their sync (which waits for the disk, seconds on a network share) runs
+  // on a thread of its own, so that no worker waits for it; one at a time (a period whose
+  // predecessor is still syncing is skipped, its layers go with the next).
+  // std::async's future waits in its destructor, so an exception leaves no thread behind.
+  std::future<void> pending_manifest;
+  // A job that stops on an error from here on (a full disk, a failing layer) first writes a last
+  // manifest listing the layers it finished, synced, so that --resume keeps them. Best effort:
+  // when that fails too (the disk is full), the original error is the one reported.
+  const OnUnwind last_words([&] {
+    if (pending_manifest.valid()) pending_manifest.wait();
+    write_manifest(false);
+    end_journal();
+  });
+  auto write_manifest_behind = [&] {
+    if (pending_manifest.valid()) {
+      if (pending_manifest.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+      pending_manifest.get();  // rethrows its error
+    }
+    std::string lines;
+    for (const ManifestLayer& l : unjournaled) lines += journal_line(l);
+    unjournaled.clear();
+    pending_manifest = std::async(std::launch::async, [lines = std::move(lines), dir = opt.out_dir, journal] {
+      io::sync_folder_contents(dir);
+      io::append_synced(journal, lines);
+    });
+    last_manifest = Clock::now();
+  };
+
+  est.layers = static_cast<int>(todo.size());
+  est.voxels = static_cast<std::int64_t>(todo.size()) * grid.voxels_per_layer();
+  est.files = est.layers + (opt.shard.count == 1 ? 2 : 1);
+  int done = kept;
+  std::vector<std::vector<int>> groups;
+  {
+    const int n = static_cast<int>(todo.size()), g = grouped ? group_cap : 1;
+    int ng = (n + g - 1) / g;
+    if (grouped) ng = std::min(n, (ng + threads - 1) / threads * threads);
+    for (int i = 0, at = 0; i < ng; ++i) {
+      const int size = n / ng + (i < n % ng ? 1 : 0);
+      groups.emplace_back(todo.begin() + at, todo.begin() + at + size);
+      at += size;
+    }
+  }
+  std::size_t next = 0;
+
   const auto pipeline_t0 = Clock::now();
+  // At most `threads` workers (fewer than the cores when max_memory_bytes says so).
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
   tbb::parallel_pipeline(
       static_cast<std::size_t>(tokens),
       tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
@@ -658,6 +780,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
               const std::string name = cfg.slice_name(out.layer);
               io::write_file_atomically(opt.out_dir / name, out.png, io::Durability::deferred);
               finished[out.layer] = ManifestLayer{out.layer, name, out.sha256, out.counts, out.failures};
+              unjournaled.push_back(finished[out.layer]);
               ++done;
               if (std::chrono::duration<double>(Clock::now() - last_manifest).count() >= opt.manifest_interval_s) {
                 write_manifest_behind();
@@ -667,9 +790,10 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
                          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
             }
           }));
+  });
 
   const double pipeline_seconds = std::chrono::duration<double>(Clock::now() - pipeline_t0).count();
-  if (pending_manifest.valid()) pending_manifest.get();  // before the last manifest replaces it
+  if (pending_manifest.valid()) pending_manifest.get();  // before the whole manifest replaces the journal
   std::vector<std::int64_t> totals(static_cast<std::size_t>(nmat), 0);
   std::int64_t failures = 0;
   for (const auto& [k, l] : finished) {
@@ -687,6 +811,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   sum.pipeline_seconds = pipeline_seconds;
   sum.layer_range = manifest.layer_range;
   sum.shard = opt.shard;
+  sum.estimate = est;
   for (const Scratch& s : scratch)
     for (std::size_t i = 0; i < s.seconds.size(); ++i) sum.stage_seconds[i] += s.seconds[i];
   for (int m = 0; m < nmat; ++m) {
@@ -710,6 +835,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     }
   }
   write_manifest(opt.last_output);
+  end_journal();
   sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return sum;
 }

@@ -2,6 +2,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <optional>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -12,6 +13,8 @@
 #include <memory>
 #include <system_error>
 
+#include "thread_time.hpp"
+#include "trivox/byte_size.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/io/model_file.hpp"
@@ -28,6 +31,8 @@ namespace trivox::job {
 namespace fs = std::filesystem;
 
 namespace {
+
+using detail::thread_cpu_seconds;
 
 constexpr int leaf_dim = io::vdb_leaf_dim;       // the VDB's leaves are 8^3 voxels
 constexpr double max_axis = 1073741824.0;        // 2^30 sub-samples along an axis
@@ -215,11 +220,6 @@ namespace {
 /// default job: 48.8 M active voxels of 10 values peaked at 2.25 GB; the model gives 2.49 GB).
 constexpr double memory_base = 150e6;      // the model, its locator, the process
 constexpr double leaf_overhead = 1.2;      // leaves store inactive values near the surface too
-std::string gigabytes(double b) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g GB", b / 1e9);
-  return buf;
-}
 }  // namespace
 
 VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
@@ -263,8 +263,8 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
                          static_cast<double>(task_voxels) * (plan.grids_values + 4) * 8.0;
   const double room = static_cast<double>(opt.max_memory_bytes) - memory_base - workers;
   if (!(room > 0.0))
-    throw Error("--max-memory " + gigabytes(static_cast<double>(opt.max_memory_bytes)) + ": below what any VDB job needs (" +
-                gigabytes(memory_base + workers) + " before its grids); expected more memory");
+    throw Error("--max-memory " + memory_size_text(static_cast<double>(opt.max_memory_bytes)) + ": below what any VDB job needs (" +
+                memory_size_text(memory_base + workers) + " before its grids); expected more memory");
   if (opt.voxel_mm) {
     plan.voxel_mm = *opt.voxel_mm;
   } else {
@@ -307,8 +307,8 @@ VdbPlan plan_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt) {
   plan.estimated_memory_bytes = memory_base + workers + plan.estimated_active_voxels * share * bytes_per_active;
   if (plan.estimated_memory_bytes > static_cast<double>(opt.max_memory_bytes))
     throw Error("--vdb-voxel " + num(vx) + ": about " + num(plan.estimated_active_voxels * share) + " active voxels of " +
-                std::to_string(plan.grids_values) + " values each, an estimated " + gigabytes(plan.estimated_memory_bytes) +
-                " of memory; expected at most " + gigabytes(static_cast<double>(opt.max_memory_bytes)) +
+                std::to_string(plan.grids_values) + " values each, an estimated " + memory_size_text(plan.estimated_memory_bytes) +
+                " of memory; expected at most " + memory_size_text(static_cast<double>(opt.max_memory_bytes)) +
                 " (raise --max-memory, or a larger --vdb-voxel)");
   if (opt.layer_range) {
     const auto [first, end] = *opt.layer_range;
@@ -330,9 +330,12 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   const Layout layout = make_layout(model, palette, opt.color_space);
   const std::string model_sha =
       !opt.model_sha256.empty() ? opt.model_sha256 : opt.model_file.empty() ? std::string() : io::sha256_file(opt.model_file);
-  prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
-  // The grids, filled with the tasks' leaves in task order.
-  io::VdbVolume volume(volume_spec(model, plan, palette, layout, opt, model_sha));
+  // The grids, filled with the tasks' leaves in task order (none in a dry run).
+  std::optional<io::VdbVolume> volume;
+  if (!opt.dry_run) {
+    prepare_folder(opt.out_dir, opt.require_empty_folder, opt.force);
+    volume.emplace(volume_spec(model, plan, palette, layout, opt, model_sha));
+  }
 
   const int N = plan.supersample;
   const int nx = plan.count[0], ny = plan.count[1], nz = plan.count[2];
@@ -484,10 +487,41 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
 
   VdbJobSummary sum;
   sum.plan = plan;
+  sum.tasks = tasks;
   sum.material_volume_mm3.assign(static_cast<std::size_t>(M), 0.0);
+  const int threads = static_cast<int>(tbb::this_task_arena::max_concurrency());
+  if (opt.dry_run) {
+    // The time: 8 tasks evenly spread over the task order (which runs slab by slab up the
+    // model) run in memory, their mean CPU time over the tasks.
+    constexpr int probe_tasks = 8;
+    std::vector<int> probe;
+    for (int q = 0; q < probe_tasks; ++q)
+      if (const int t = static_cast<int>(static_cast<std::int64_t>(tasks) * (2 * q + 1) / (2 * probe_tasks));
+          t < tasks && (probe.empty() || probe.back() != t))
+        probe.push_back(t);
+    std::vector<double> cpu(probe.size());
+    tbb::parallel_for(std::size_t{0}, probe.size(), [&](std::size_t i) {
+      const double c0 = thread_cpu_seconds();
+      (void)run_task(probe[i]);
+      cpu[i] = thread_cpu_seconds() - c0;
+    });
+    double total = 0.0;
+    for (double c : cpu) total += c;
+    sum.dry_run = true;
+    sum.timed_tasks = static_cast<int>(probe.size());
+    sum.estimated_seconds = probe.empty() ? 0.0 : total / static_cast<double>(probe.size()) * tasks / threads;
+    sum.file = plan.file;
+    for (const auto& m : palette.materials) sum.materials.push_back(m.name);
+    sum.palette = palette.name;
+    sum.units = vdb_units_name(opt.units);
+    sum.color_space = vdb_color_space_name(opt.color_space);
+    sum.colour_source = layout.rgb ? "r,g,b" : "palette";
+    sum.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return sum;
+  }
   double density_sum = 0.0;
   int done = 0, next = 0;
-  const int tokens = static_cast<int>(tbb::this_task_arena::max_concurrency()) + 1;
+  const int tokens = threads + 1;
   tbb::parallel_pipeline(
       static_cast<std::size_t>(tokens),
       tbb::make_filter<void, int>(tbb::filter_mode::serial_in_order,
@@ -502,7 +536,7 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
               tbb::filter_mode::parallel, [&](int t) { return std::make_shared<TaskOut>(run_task(t)); }) &
           tbb::make_filter<std::shared_ptr<TaskOut>, void>(tbb::filter_mode::serial_in_order, [&](std::shared_ptr<TaskOut> o) {
             // The grids take the leaves over (each is a new leaf position: tasks are disjoint).
-            volume.adopt(o->leaves);
+            volume->adopt(o->leaves);
             sum.active_voxels += o->active;
             sum.fractional_voxels += o->fractional;
             sum.inversion_failures += o->failures;
@@ -519,8 +553,8 @@ VdbJobSummary run_vdb_job(const vmodel::VModel& model, const VdbJobOptions& opt,
   sum.volume_mm3 = density_sum * voxel_volume;
   for (double& v : sum.material_volume_mm3) v *= voxel_volume;
 
-  const auto [bytes, digest] = volume.write(plan.file);
-  sum.grids = volume.grid_names();
+  const auto [bytes, digest] = volume->write(plan.file);
+  sum.grids = volume->grid_names();
 
   sum.file = plan.file;
   sum.materials.reserve(static_cast<std::size_t>(M));

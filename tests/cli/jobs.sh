@@ -77,7 +77,35 @@ sleep 3
 kill -9 %1 2>/dev/null || true
 wait %1 2>/dev/null || true
 [ ! -e "$tmp/killed/ConfigFile.xml" ] || echo "note: the job finished before the kill"
-"$trivox" slice models/twisted_column.json -o "$tmp/killed" "${big[@]}" --resume > /dev/null
+# The killed job's record: manifest.json as written at its start, and the journal of the layers
+# finished since, bound to that manifest by its SHA-256; every layer listed is on disk, whole.
+"$py" - "$tmp/killed" > "$tmp/journaled" <<'PY'
+import sys, os, json, hashlib
+d = sys.argv[1]
+sha = lambda p: hashlib.sha256(open(p, "rb").read()).hexdigest()
+m = json.load(open(os.path.join(d, "manifest.json")))
+listed = {l["index"]: l for l in m["layers"]}
+j = os.path.join(d, "manifest.journal")
+if os.path.exists(j):
+    text = open(j, "rb").read()
+    lines = text.split(b"\n")[:-1]      # whole lines only
+    head = json.loads(lines[0])
+    assert head == {"trivox_journal": 1, "manifest_sha256": sha(os.path.join(d, "manifest.json"))}, head
+    for line in lines[1:]:
+        l = json.loads(line)
+        listed[l["index"]] = l
+for l in listed.values():
+    assert l["sha256"] == sha(os.path.join(d, l["file"])), l["file"]
+print(len(listed))
+PY
+"$trivox" slice models/twisted_column.json -o "$tmp/killed" "${big[@]}" --resume --json > "$tmp/killed.json"
+"$py" - "$tmp/killed.json" "$(cat "$tmp/journaled")" <<'PY'
+import sys, json
+kept = json.load(open(sys.argv[1]))["layers_kept"]
+assert kept == int(sys.argv[2]), (kept, sys.argv[2])   # --resume keeps every layer recorded
+if kept == 0: print("note: the kill came before the first journal entry")
+PY
+[ ! -e "$tmp/killed/manifest.journal" ]
 "$trivox" slice models/twisted_column.json -o "$tmp/straight" --threads 2 --progress never > /dev/null
 same_folder "$tmp/straight" "$tmp/killed"
 # Killed again, now while --force overwrites that finished job with another: the earlier job's

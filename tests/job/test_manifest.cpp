@@ -2,11 +2,13 @@
 // round trip and its refusals.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
 #include <map>
 #include <vector>
 #include <string>
 
 #include "trivox/error.hpp"
+#include "trivox/io/model_file.hpp"
 #include "trivox/job/manifest.hpp"
 #include "../io/io_test_util.hpp"
 
@@ -273,4 +275,81 @@ TEST_CASE("derived names: the whole VDB from the model's name, the archive from 
   CHECK(vdb_file_name(m) == "teapot.vdb");
   CHECK(zip_entry_name("jobs/teapot") == "../teapot.gcvf");
   CHECK(zip_entry_name("jobs/teapot/") == "../teapot.gcvf");
+}
+
+TEST_CASE("a journal adds the layers finished after its manifest, and only to that manifest", "[manifest][journal]") {
+  Manifest m = sample();
+  m.complete = false;
+  const std::vector<ManifestLayer> all = m.layers;  // layers 8, 10, 12, 14 of shard 1 of 3
+  REQUIRE(all.size() >= 4);
+  // The manifest written at the start lists the first layer; the journal the others, in the
+  // order they finished (not ascending), one of them twice (the later line wins).
+  Manifest start = m;
+  start.layers = {all[0]};
+  const std::string text = manifest_json(start);
+  ManifestLayer redone = all[2];
+  redone.sha256 = std::string(64, 'd');
+  const std::string journal = journal_header(text) + journal_line(all[3]) + journal_line(all[2]) +
+                              journal_line(all[1]) + journal_line(redone);
+
+  SECTION("every whole line of a journal of this manifest") {
+    Manifest read = parse_manifest(text, "m.json");
+    CHECK(apply_journal(read, text, journal) == 3);
+    Manifest expect = m;
+    expect.layers[2] = redone;
+    CHECK(read.layers == expect.layers);
+    CHECK(manifest_json(read) == manifest_json(expect));
+  }
+  SECTION("a last line cut short by a kill is left out, and so is everything after a damaged line") {
+    Manifest read = parse_manifest(text, "m.json");
+    const std::string cut = journal.substr(0, journal.size() - 10);
+    CHECK(apply_journal(read, text, cut) == 3);  // all[3], all[2], all[1]; redone cut
+    CHECK(read.layer(all[2].index)->sha256 == all[2].sha256);
+
+    Manifest read2 = parse_manifest(text, "m.json");
+    const std::string damaged = journal_header(text) + journal_line(all[3]) + "{\"index\": 1\n" + journal_line(all[1]);
+    CHECK(apply_journal(read2, text, damaged) == 1);
+    CHECK(read2.layers.size() == 2);
+    // A line naming a layer outside the shard's range, or another file name, ends the journal.
+    Manifest read3 = parse_manifest(text, "m.json");
+    ManifestLayer outside = all[1];
+    outside.index = m.layer_range[1];
+    outside.file = "slice_" + std::to_string(outside.index) + ".png";
+    ManifestLayer escaping = all[1];
+    escaping.file = "../slice_" + std::to_string(escaping.index) + ".png";
+    CHECK(apply_journal(read3, text, journal_header(text) + journal_line(outside) + journal_line(all[1])) == 0);
+    CHECK(apply_journal(read3, text, journal_header(text) + journal_line(escaping)) == 0);
+    CHECK(read3.layers.size() == 1);
+  }
+  SECTION("a journal of another manifest, or of a complete one, adds nothing") {
+    Manifest other = start;
+    other.model_sha256 = std::string(64, 'e');
+    const std::string other_text = manifest_json(other);
+    Manifest read = parse_manifest(text, "m.json");
+    CHECK(apply_journal(read, text, journal_header(other_text) + journal_line(all[1])) == 0);
+    CHECK(apply_journal(read, text, journal_line(all[1]) + journal_line(all[2])) == 0);  // no header
+    CHECK(apply_journal(read, text, "") == 0);
+    CHECK(read.layers.size() == 1);
+    Manifest done = start;
+    done.complete = true;
+    const std::string done_text = manifest_json(done);
+    Manifest read_done = parse_manifest(done_text, "m.json");
+    CHECK(apply_journal(read_done, done_text, journal_header(done_text) + journal_line(all[1])) == 0);
+  }
+  SECTION("read_manifest applies the journal beside the manifest") {
+    const io::test::TempDir tmp("journal");
+    const auto& dir = tmp.path();
+    io::write_file_atomically(dir / m.shard.manifest_name(), text);
+    io::write_file_atomically(dir / m.shard.journal_name(), journal);
+    CHECK(m.shard.journal_name() == "manifest.shard-1-of-3.journal");
+    CHECK(journal_name_of("manifest.json") == "manifest.journal");
+    const auto read = read_manifest(dir, m.shard.manifest_name());
+    REQUIRE(read);
+    CHECK(read->layers.size() == all.size());
+    // A journal that is a link is left out.
+    std::filesystem::remove(dir / m.shard.journal_name());
+    io::write_file_atomically(dir / "elsewhere", journal);
+    std::filesystem::create_symlink("elsewhere", dir / m.shard.journal_name());
+    CHECK(read_manifest(dir, m.shard.manifest_name())->layers.size() == 1);
+  }
 }

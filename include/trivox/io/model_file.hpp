@@ -75,6 +75,12 @@ enum class Durability {
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes,
                            Durability durability = Durability::synced);
 
+/// Appends `bytes` to the existing regular file `path` (a journal) and syncs it (fdatasync)
+/// before returning. The file is opened without following a symbolic link.
+/// @throws trivox::Error naming the path: failed for a full disk or a failing device, bad_input
+///         for a missing file, a link or a path the user may not write
+void append_synced(const std::filesystem::path& path, std::string_view bytes);
+
 /// Flushes every file written so far in the file system that holds `dir` (syncfs).
 /// @throws trivox::Error (failed) naming the folder when the system reports a write error
 void sync_folder_contents(const std::filesystem::path& dir);

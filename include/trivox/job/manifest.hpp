@@ -5,9 +5,11 @@
 /// A manifest names the job (trivox version, the model file's SHA-256, every option that changes
 /// the output, the grid) and lists, per finished layer, its file, SHA-256, voxels per material
 /// and inversion failures, plus the job's other files (VDB, ConfigFile.xml, .gcvf) with their
-/// SHA-256. docs/slice-output.md has the format. The job rewrites it atomically as layers
-/// complete (every few seconds, and at the end), always after the layers it lists are on disk,
-/// so after a kill it lists only complete layers.
+/// SHA-256. docs/slice-output.md has the format. A running job writes it once at its start and
+/// appends the layers it finishes to a journal beside it (`manifest.journal`, every few seconds,
+/// always after the layers it lists are on disk), then rewrites it whole at the end, listing
+/// every layer, and removes the journal; so after a kill the manifest and its journal list only
+/// complete layers, and the cost of keeping them is linear in the layer count.
 ///
 /// Shards: job K of N (`--shard K/N`, or a scheduler's array index) slices a contiguous range of
 /// layers aligned on 8 layers (an OpenVDB leaf's depth) and writes `manifest.shard-K-of-N.json`;
@@ -56,6 +58,8 @@ struct Shard {
   bool operator==(const Shard&) const = default;
   /// "manifest.json" for a whole job, "manifest.shard-K-of-N.json" for a shard.
   std::string manifest_name() const;
+  /// Its journal: "manifest.journal", "manifest.shard-K-of-N.journal".
+  std::string journal_name() const;
   /// A file name with ".shard-K-of-N" before the extension for a shard (model.vdb ->
   /// model.shard-1-of-3.vdb), unchanged for a whole job.
   std::string part_name(const std::string& name) const;
@@ -129,8 +133,35 @@ std::string manifest_json(const Manifest& manifest);
 ///         the folder"
 Manifest parse_manifest(std::string_view text, const std::string& source);
 
+/// The journal of a running job: the layers it finished since its manifest was written, one
+/// JSON object per line (JSON Lines), appended every few seconds after the layers it lists are
+/// on disk. Its first line binds it to the manifest it extends:
+/// `{"trivox_journal":1,"manifest_sha256":"<SHA-256 of the manifest file's bytes>"}`, so a
+/// journal left beside another manifest (a later job's, or the job's own compacted one) is never
+/// read into it. Each further line is a layer as in the manifest's "layers".
+
+/// The journal name of manifest `manifest_name` (".json" replaced by ".journal").
+std::string journal_name_of(const std::string& manifest_name);
+
+/// A new journal's first line for the manifest whose file bytes are `manifest_text`.
+std::string journal_header(std::string_view manifest_text);
+
+/// One finished layer as a journal line (compact JSON and a newline).
+std::string journal_line(const ManifestLayer& layer);
+
+/// Adds the layers of `journal_text` to `manifest` (parsed from `manifest_text`), keeping its
+/// layers in ascending order (a journal's layer replaces the manifest's of the same index).
+/// Nothing is added when the journal belongs to another manifest (its header's digest differs)
+/// or the manifest is complete. A last line without its newline (a write cut short by a kill)
+/// and every line from the first that does not read as a layer of this manifest onwards are
+/// left out: the layers they name are simply redone by `--resume`.
+/// @return the number of layers read from the journal
+std::size_t apply_journal(Manifest& manifest, std::string_view manifest_text, std::string_view journal_text);
+
 /// Reads `dir / name` when it exists; nothing when it does not. The file is opened without
-/// following a symbolic link (io::read_regular_file) and may hold at most 256 MiB.
+/// following a symbolic link (io::read_regular_file) and may hold at most 256 MiB. An incomplete
+/// manifest gets the layers of its journal (`journal_name_of(name)`, apply_journal) when that is
+/// a regular file of at most 256 MiB; otherwise the journal is left out.
 /// @throws Error (bad_input) when it exists but is a link or not a regular file, is too large,
 ///         cannot be read or does not parse
 std::optional<Manifest> read_manifest(const std::filesystem::path& dir, const std::string& name);

@@ -10,12 +10,14 @@
 /// paints (encode_png_indexed); an in-order
 /// stage writes each slice to a temporary name and renames it. ConfigFile.xml is written last,
 /// after a sync, so an interrupted job never looks complete. The manifest (manifest.hpp) is
-/// rewritten every few seconds after a sync; it lets a killed job resume (`resume`: listed layers
+/// written at the start and the end, the layers finished in between appended to its journal
+/// every few seconds after a sync; it lets a killed job resume (`resume`: listed layers
 /// whose SHA-256 still matches are kept) and a job run as shards (`shard`: a range of whole
 /// 8-layer blocks, merged by merge_job). Memory: per worker one layer of RGBA pixels
 /// (width x height x 4 bytes), or on the grouped path 8 layers of indices (8 bytes per pixel,
-/// grouping only where those fit in 1 GiB over all workers), plus one band of samples per layer;
-/// it does not grow with the layer count.
+/// grouping only where those fit in 1 GiB over all workers and within max_memory_bytes), plus
+/// one band of samples per layer and the encoded layers in flight; it does not grow with the
+/// layer count (SliceJobEstimate::memory_bytes has the model).
 /// Output is byte-identical for any thread count (every layer depends on its own inputs only).
 /// Masalha, Cirillo & Elber 2021, Sec. 8 (slicing for VoxelPrint).
 #pragma once
@@ -50,7 +52,16 @@ struct SliceJobOptions {
   /// ConfigFile.xml declares it as BackGroundMaterialRGBA. With "black", a palette material
   /// coloured 0 0 0 255 is refused.
   std::string background = "transparent";
-  std::int64_t max_voxels = 100'000'000'000;   ///< refuse larger grids unless force
+  /// Refuse grids of more voxels, or more layers (and so files). `force` does not lift these:
+  /// raise them (`--max-voxels`, `--max-layers`).
+  std::int64_t max_voxels = 100'000'000'000;
+  std::int64_t max_layers = 100'000;
+  /// The memory the job may use (`--max-memory`): grouped dithering only where it fits; a job
+  /// whose estimate (SliceJobEstimate::memory_bytes) exceeds it even ungrouped is refused.
+  std::int64_t max_memory_bytes = std::int64_t{2} << 30;
+  /// Check everything, time a few layers and report the estimate (SliceJobSummary::estimate)
+  /// without creating the folder or writing any file.
+  bool dry_run = false;
   int band_rows = 64;                          ///< rows sampled and dithered at a time
   slice::SamplerOptions sampler;               ///< sampling options (the Shepard blend, --blend)
   /// slice::model_bounds(model), when the caller has it already (a job that also writes a VDB):
@@ -69,6 +80,25 @@ struct SliceJobOptions {
   /// call finish_manifest; until then the manifest says complete: false.
   bool last_output = true;
   double manifest_interval_s = 2.0;            ///< rewrite the manifest at most this often
+};
+
+/// What a job will cost, estimated before it starts (`--dry-run` prints it). The time and the
+/// output size extrapolate from 8 layers evenly spread over the job's range, sliced, dithered
+/// and encoded in memory; the memory adds to what the process holds already (the libraries,
+/// the model and its locator, read from /proc/self/statm) 32 MiB for the threads and the
+/// encoder, each worker's buffers and the encoded layers in flight (half a byte per pixel).
+struct SliceJobEstimate {
+  int layers = 0;                   ///< layers to write (this shard's, less those kept)
+  int files = 0;                    ///< files written: slices, ConfigFile.xml, the manifest
+  std::int64_t voxels = 0;          ///< voxels of those layers
+  int threads = 0;                  ///< worker threads
+  bool grouped = false;             ///< layers dithered 8 at a time (within max_memory_bytes)
+  double memory_bytes = 0.0;        ///< peak resident memory
+  double base_bytes = 0.0;          ///< of it, what the process held before the job
+  double seconds = 0.0;             ///< wall time of the layers (setup, sync and manifest not included)
+  double output_bytes = 0.0;        ///< the slices' size on disk
+  int timed_layers = 0;             ///< layers the figures extrapolate from
+  double seconds_per_layer = 0.0;   ///< CPU time of one layer (mean over the timed layers)
 };
 
 /// What a job did, for the summary.
@@ -96,6 +126,8 @@ struct SliceJobSummary {
   int layers_kept = 0;                   ///< layers a resumed job found done and verified
   std::array<int, 2> layer_range{};      ///< the layers this job (shard) covers, [first, end)
   Shard shard;
+  SliceJobEstimate estimate;             ///< made before the layers (the whole result of a dry run)
+  bool dry_run = false;                  ///< nothing was written
 };
 
 /// Names of SliceJobSummary::stage_seconds, in order.
@@ -130,7 +162,8 @@ void finish_manifest(const std::filesystem::path& dir, const Shard& shard, const
 /// Runs the job. @throws Error (bad_input) for bad options (among them a resolution or layer
 /// that is not a whole number of dots per inch or nanometres, which ConfigFile.xml cannot hold,
 /// and a palette of more materials than the printer's channels), an unusable output folder, a job
-/// larger than the tray or max_voxels (unless force), a malformed palette; (failed) when the PNG
+/// larger than the tray (unless force), of more than max_voxels voxels or max_layers layers, or
+/// whose estimated memory exceeds max_memory_bytes, a malformed palette; (failed) when the PNG
 /// module cannot be loaded (checked before the folder is made) or writing fails midway.
 SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions& options,
                               const SliceProgress& progress = {});

@@ -104,6 +104,9 @@ struct VdbJobOptions {
   /// computed.
   std::optional<std::array<slice::Vec3, 2>> model_box;
   std::optional<double> model_volume_mm3;
+  /// Plan, then time a few tasks in memory (VdbJobSummary::estimated_seconds) without creating
+  /// the folder or writing anything (`--dry-run`).
+  bool dry_run = false;
   /// The SHA-256 of model_file's bytes (hex), when the caller has it already (`trivox slice`
   /// hashes the model once for its manifest); empty: computed from model_file.
   std::string model_sha256;
@@ -148,6 +151,10 @@ struct VdbJobSummary {
   std::string sha256;                     ///< of the written file
   std::int64_t bytes = 0;                 ///< file size
   double seconds = 0.0;
+  int tasks = 0;                          ///< tasks of the job (slabs of 8 layers by bands of rows)
+  bool dry_run = false;                   ///< nothing was written; the figures are estimates
+  int timed_tasks = 0;                    ///< a dry run's tasks timed in memory
+  double estimated_seconds = 0.0;         ///< a dry run's wall-time estimate: mean task CPU x tasks / threads
 };
 
 /// Progress: tasks done of total, sub-samples done, seconds since the start.
