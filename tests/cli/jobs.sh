@@ -161,7 +161,8 @@ cmp "$tmp/whole.gcvf" "$tmp/s/whole.gcvf"
 rm "$sharded/manifest.json" "$sharded/ConfigFile.xml"
 mv "$sharded/manifest.shard-1-of-3.json" "$tmp/shard1.json"
 expect_fail "rerun only --shard 1/3" "$trivox" merge "$sharded"
-[ ! -e "$sharded/ConfigFile.xml" ] && [ ! -e "$sharded/manifest.json" ]
+[ ! -e "$sharded/ConfigFile.xml" ]
+[ ! -e "$sharded/manifest.json" ]
 mv "$tmp/shard1.json" "$sharded/manifest.shard-1-of-3.json"
 echo x >> "$sharded/slice_87.png"
 expect_fail "shard 2/3: 1 file(s) missing or changed" "$trivox" merge "$sharded"

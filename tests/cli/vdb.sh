@@ -212,7 +212,8 @@ cmp "$tmp/g1/graded_block.vdb" "$tmp/g2/graded_block.vdb"
 # written alone.
 "$trivox" slice models/graded_block.json -o "$tmp/g3" --dpi 25,25 --layer 1.016 --threads 2 $q > /dev/null
 for f in "$tmp"/g3/slice_*.png "$tmp/g3/ConfigFile.xml"; do cmp "$f" "$tmp/g1/$(basename "$f")"; done
-[ -f "$tmp/g1/ConfigFile.xml" ] && [ -f "$tmp/g1/slice_0.png" ]
+[ -f "$tmp/g1/ConfigFile.xml" ]
+[ -f "$tmp/g1/slice_0.png" ]
 "$py" - "$tmp/g1" <<'PY'
 import sys, json, hashlib, os
 d = sys.argv[1]
