@@ -4,12 +4,14 @@
 set -euo pipefail
 
 # Build: the compiler and tools; Eigen, TBB, nlohmann/json, CLI11, pugixml (G+Smo XML and
-# ConfigFile.xml), libzip (.gcvf), OpenSSL (SHA-256), OpenVDB (with Boost iostreams),
-# OpenImageIO (the PNG module; its CMake package wants OpenCV's headers and its own tools).
+# ConfigFile.xml), libzip (.gcvf), OpenSSL (SHA-256), OpenVDB (with Boost iostreams), lib3mf
+# (3MF meshes), OpenImageIO (the PNG module; its CMake package wants OpenCV's headers and its
+# own tools).
 # Tests: Catch2, OpenVDB's tools (vdb_print, vdb_render) and the Python modules of OpenVDB and
 # OpenImageIO as independent readers, unzip for the .gcvf archives, Blender (run headless) as a
-# real client of the VDB volumes, Slurm and munge (a one-node cluster started by a test) and
-# PyYAML (the Kubernetes Job manifests of docs/jobs.md) for the schedulers users run trivox on.
+# real client of the VDB volumes and the meshes, admesh as an independent checker of STL meshes,
+# Slurm and munge (a one-node cluster started by a test) and PyYAML (the Kubernetes Job
+# manifests of docs/jobs.md) for the schedulers users run trivox on.
 # Sanitizers and fuzzing (tools/sanitize.sh, tools/fuzz.sh): clang 14 and its runtimes (ASan,
 # UBSan, libFuzzer for -fsanitize=fuzzer), which clang only recommends.
 packages=(
@@ -18,6 +20,7 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev
   libopenimageio-dev libopencv-core-dev openimageio-tools
   catch2 libopenvdb-tools python3-openvdb python3-openimageio unzip blender
+  lib3mf-dev admesh
   slurm-wlm munge python3-yaml
   clang libclang-rt-14-dev
 )

@@ -27,6 +27,7 @@ void add_merge(CLI::App& app, Common& common);
 void add_validate(CLI::App& app, Common& common);
 void add_build(CLI::App& app, Common& common);
 void add_construct(CLI::App& app, Common& common);
+void add_mesh(CLI::App& app, Common& common);
 
 /// Registers the global option `--limit NAME=N` (repeatable; given before or after the command,
 /// thanks to fallthrough) on the main app: each sets one input limit (trivox/limits.hpp) in the

@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
   trivox::cli::add_validate(app, common);
   trivox::cli::add_build(app, common);
   trivox::cli::add_construct(app, common);
+  trivox::cli::add_mesh(app, common);
   trivox::cli::add_limit_option(app);
   try {
     trivox::cli::apply_limits_environment();

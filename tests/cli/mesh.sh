@@ -1,0 +1,172 @@
+#!/usr/bin/env bash
+# End-to-end: `trivox mesh` (docs/mesh.md) checked by independent readers.
+# Truths:
+# - The G+Smo Fichera corner is 7 unit cubes (2 x 2 x 2 less one): its boundary is 24 unit squares
+#   (48 triangles, area 24, volume 7), 26 lattice points, one shell, V - E + F = 2. The G+Smo cube
+#   [-1, 2]^3 of 7 cells has 6 boundary faces: 12 triangles, volume 27, area 54.
+# - admesh (an independent STL reader) finds every facet connected with 0 degenerate facets,
+#   0 edges fixed, 0 backwards edges, 0 normals fixed, the expected number of parts, and our
+#   volume to float precision.
+# - The twisted column (4 curved cells) is one shell whose volume is the cells' quadrature volume
+#   up to the tessellation error, at most tolerance x area; a finer tolerance gives a smaller error.
+# - The primitives scene built into a model: 5 separate solids (box, cylinder, cone, torus,
+#   sphere), Euler characteristic 4 x 2 + 0 (the torus has genus 1).
+# - PLY and OBJ open in Blender (headless) with our vertex and face counts and a colour
+#   attribute; the PLY header and the 3MF's XML (unzipped by Python) say what docs/mesh.md says.
+# - Refusals: trimmed cells (exit 2, naming the cell), overlapping cells (exit 1, nothing
+#   written), bad paths, formats and tolerances (exit 2, nothing written).
+set -euo pipefail
+source tests/cli/lib.bash "$@"
+
+json() { "$py" -c "import json,sys; d=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))" "$@"; }
+
+# --- exact solids, read back by admesh -----------------------------------------------------------
+"$trivox" mesh models/gismo/fichera.xml -o "$tmp/fichera.stl" --json > "$tmp/fichera.json"
+"$trivox" mesh models/gismo/cube.xml -o "$tmp/cube.stl" --json > "$tmp/cube.json"
+"$py" - "$tmp/fichera.json" "$tmp/cube.json" <<'PY'
+import json, sys
+f, c = (json.load(open(p)) for p in sys.argv[1:])
+assert (f["triangles"], f["vertices"], f["shells"], f["euler"], f["manifold"]) == (48, 26, 1, 2, True), f
+assert abs(f["volume"] - 7) < 1e-12 and abs(f["area"] - 24) < 1e-12 and abs(f["cell_volume"] - 7) < 1e-12, f
+assert (c["triangles"], c["vertices"], c["faces"], c["shells"]) == (12, 8, 6, 1), c
+assert abs(c["volume"] - 27) < 1e-12 and abs(c["area"] - 54) < 1e-12, c
+assert f["format"] == "stl" and f["colour"] is False
+PY
+
+# admesh MESH.stl PARTS VOLUME: the checker's verdict.
+admesh_check() {
+  admesh "$1" > "$tmp/admesh.txt" 2>&1
+  "$py" - "$tmp/admesh.txt" "$2" "$3" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+def field(name):
+    m = re.search(re.escape(name) + r"\s*:\s*(-?[0-9.]+)", text)
+    assert m, (name, text)
+    return float(m.group(1))
+assert field("Number of parts") == int(sys.argv[2]), text
+for name in ("Degenerate facets", "Edges fixed", "Backwards edges", "Normals fixed", "Facets removed", "Facets added",
+             "Facets reversed", "Total disconnected facets"):
+    assert field(name) == 0, (name, text)
+want = float(sys.argv[3])
+assert abs(field("Volume") - want) <= 1e-5 * abs(want), (field("Volume"), want)
+PY
+}
+admesh_check "$tmp/fichera.stl" 1 7
+admesh_check "$tmp/cube.stl" 1 27
+
+# --- curved cells: the twisted column, two tolerances ----------------------------------------------
+"$trivox" mesh models/twisted_column.json -o "$tmp/column.stl" --json > "$tmp/column.json"
+"$trivox" mesh models/twisted_column.json -o "$tmp/column_fine.stl" --tolerance 0.005 --json > "$tmp/column_fine.json"
+"$py" - "$tmp/column.json" "$tmp/column_fine.json" <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:])
+for d in (a, b):
+    assert d["manifold"] and d["shells"] == 1 and d["euler"] == 2, d
+    assert d["max_deviation"] <= d["tolerance"], d
+    err = abs(d["volume"] - d["cell_volume"])
+    assert 0 < err <= d["tolerance"] * d["area"], (err, d)
+assert b["tolerance"] == 0.005 and b["triangles"] > a["triangles"]
+assert abs(b["volume"] - b["cell_volume"]) < abs(a["volume"] - a["cell_volume"]) / 4, (a, b)
+PY
+admesh_check "$tmp/column.stl" 1 "$(json "$tmp/column.json" 'd["volume"]')"
+
+# --- five primitives with colours: STL, PLY, OBJ, 3MF -----------------------------------------------
+"$trivox" build models/primitives.json -o "$tmp/primitives.json" > /dev/null
+for f in stl ply obj 3mf; do
+  "$trivox" mesh "$tmp/primitives.json" -o "$tmp/prim.$f" --json > "$tmp/prim_$f.json"
+done
+"$trivox" mesh "$tmp/primitives.json" -o "$tmp/prim.bin" --format ply --json > "$tmp/prim_bin.json"
+cmp "$tmp/prim.ply" "$tmp/prim.bin"
+"$py" - "$tmp" <<'PY'
+import json, os, sys, struct, zipfile
+import xml.etree.ElementTree as ET
+d = sys.argv[1]
+s = json.load(open(os.path.join(d, "prim_ply.json")))
+assert s["shells"] == 5 and s["euler"] == 8 and s["manifold"] and s["colour"], s
+assert abs(s["volume"] - s["cell_volume"]) <= s["tolerance"] * s["area"], s
+for f in ("stl", "obj", "3mf"):
+    t = json.load(open(os.path.join(d, f"prim_{f}.json")))
+    assert (t["triangles"], t["vertices"], t["volume"]) == (s["triangles"], s["vertices"], s["volume"]), (f, t)
+# PLY: header and body size from the header's own declarations.
+raw = open(os.path.join(d, "prim.ply"), "rb").read()
+head, body = raw.split(b"end_header\n", 1)
+lines = head.decode().splitlines()
+assert lines[:2] == ["ply", "format binary_little_endian 1.0"], lines
+assert f"element vertex {s['vertices']}" in lines and f"element face {s['triangles']}" in lines, lines
+assert [l for l in lines if l.startswith("property uchar")] == ["property uchar red", "property uchar green", "property uchar blue"]
+assert len(body) == s["vertices"] * 15 + s["triangles"] * 13
+# The box's colour in the scene is red: some vertex is (255, 0, 0) or close.
+colours = {struct.unpack_from("<3B", body, 15 * v + 12) for v in range(s["vertices"])}
+assert len(colours) > 5, colours
+# 3MF: the zip's model XML (core + materials namespaces), millimetres, the counts, per-vertex colours.
+z = zipfile.ZipFile(os.path.join(d, "prim.3mf"))
+assert "3D/3dmodel.model" in z.namelist() and "[Content_Types].xml" in z.namelist(), z.namelist()
+root = ET.fromstring(z.read("3D/3dmodel.model"))
+core = "{http://schemas.microsoft.com/3dmanufacturing/core/2015/02}"
+mat = "{http://schemas.microsoft.com/3dmanufacturing/material/2015/02}"
+assert root.get("unit") == "millimeter", root.attrib
+verts = root.findall(f".//{core}vertex")
+tris = root.findall(f".//{core}triangle")
+assert (len(verts), len(tris)) == (s["vertices"], s["triangles"]), (len(verts), len(tris))
+group = root.find(f".//{mat}colorgroup")
+assert group is not None and len(group) > 5
+# Every triangle takes its colours from the group: p1 (one colour) or p1, p2, p3 (one per vertex).
+assert all(t.get("pid") == group.get("id") and t.get("p1") is not None for t in tris)
+assert any(t.get("p3") is not None and t.get("p3") != t.get("p1") for t in tris)
+# STL: 84 + 50 bytes per facet.
+assert os.path.getsize(os.path.join(d, "prim.stl")) == 84 + 50 * s["triangles"]
+PY
+admesh_check "$tmp/prim.stl" 5 "$(json "$tmp/prim_stl.json" 'd["volume"]')"
+
+# Blender reads the PLY and the OBJ with our counts and a colour attribute.
+if command -v blender > /dev/null; then
+  cat > "$tmp/count.py" <<'PY'
+import bpy, sys
+path = sys.argv[sys.argv.index("--") + 1]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+if path.endswith(".ply"):
+    bpy.ops.import_mesh.ply(filepath=path)
+else:
+    bpy.ops.wm.obj_import(filepath=path)
+objs = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+print("mesh_count:", sum(len(o.data.vertices) for o in objs), sum(len(o.data.polygons) for o in objs),
+      sum(len(o.data.color_attributes) for o in objs))
+PY
+  want="mesh_count: $(json "$tmp/prim_ply.json" 'd["vertices"]') $(json "$tmp/prim_ply.json" 'd["triangles"]') 1"
+  for f in ply obj; do
+    blender -b --factory-startup --python-exit-code 1 --python "$tmp/count.py" -- "$tmp/prim.$f" > "$tmp/blender.log" 2>&1 ||
+      { echo "blender failed on $f:"; cat "$tmp/blender.log"; exit 1; }
+    got=$(grep '^mesh_count:' "$tmp/blender.log")
+    if [ "$got" != "$want" ]; then echo "blender $f: '$got', expected '$want'"; exit 1; fi
+  done
+else
+  echo "blender is not installed: the Blender import is skipped (tools/setup.sh installs it)"
+fi
+
+# Per cell: every cell its own closed shell.
+"$trivox" mesh "$tmp/primitives.json" -o "$tmp/cells.stl" --cells --json > "$tmp/cells.json"
+"$py" - "$tmp/cells.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["cells"] and d["manifold"] and d["shells"] == 1 + 5 + 5 + 5 + 7, d  # box, cylinder, cone, torus, ball cells
+PY
+
+# --- refusals ----------------------------------------------------------------------------------
+"$trivox" build models/quickstart.json -o "$tmp/quickstart.json" > /dev/null
+expect_exit 2 'cell "plate" (0): trimmed by a Boolean' "$tmp/q.stl" "$trivox" mesh "$tmp/quickstart.json" -o "$tmp/q.stl"
+"$trivox" build models/box_cylinder.json -o "$tmp/box_cylinder.json" > /dev/null
+expect_exit 1 'not a closed manifold' "$tmp/bc.stl" "$trivox" mesh "$tmp/box_cylinder.json" -o "$tmp/bc.stl"
+expect_exit 2 'expected .stl, .ply, .obj or .3mf' "$tmp/x.txt" "$trivox" mesh models/gismo/cube.xml -o "$tmp/x.txt"
+expect_exit 2 'unknown format' "$tmp/x.stl" "$trivox" mesh models/gismo/cube.xml -o "$tmp/x.stl" --format vrml
+expect_exit 2 'expected a finite length > 0' "$tmp/x.stl" "$trivox" mesh models/gismo/cube.xml -o "$tmp/x.stl" --tolerance -1
+expect_exit 2 'does not exist' "$tmp/no/x.stl" "$trivox" mesh models/gismo/cube.xml -o "$tmp/no/x.stl"
+mkdir "$tmp/folder.stl"
+expect_exit 2 "is a folder" - "$trivox" mesh models/gismo/cube.xml -o "$tmp/folder.stl"
+expect_exit 2 'no cells' "$tmp/t.stl" "$trivox" mesh models/gismo/teapot.xml -o "$tmp/t.stl"
+if [ "$(id -u)" -ne 0 ]; then  # root writes anywhere
+  mkdir "$tmp/ro" && chmod 555 "$tmp/ro"
+  expect_exit 2 'is not writable' "$tmp/ro/x.stl" "$trivox" mesh models/gismo/cube.xml -o "$tmp/ro/x.stl"
+fi
+# No temporary left behind by any of the runs.
+if ls -a "$tmp" | grep -q '\.tmp-'; then echo "temporary files left:"; ls -a "$tmp"; exit 1; fi
+echo "mesh: ok"
