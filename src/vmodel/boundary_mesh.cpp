@@ -319,7 +319,6 @@ BoundaryMesh mesh_boundary(const VModel& model, const MeshOptions& options) {
   BoundaryMesh mesh;
   mesh.property_names = model.properties;
   if (n_cells == 0) return mesh;
-  const Topology topo = build_topology(model);
 
   // The tolerance, from the diagonal of the xyz control box when not given.
   Vec3 lo{}, hi{};
@@ -336,6 +335,12 @@ BoundaryMesh mesh_boundary(const VModel& model, const MeshOptions& options) {
   const double tol = options.tolerance > 0.0 ? options.tolerance : options.relative_tolerance * diag;
   if (!(tol > 0.0)) throw Error("mesh: the model has no extent (diagonal 0); expected cells with volume");
   mesh.tolerance = tol;
+  // Geometry that agrees within 1% of the chordal tolerance is one at the mesh's resolution:
+  // faces, edges and corners are glued that close (a ring closed by fitting meets itself only
+  // approximately; 1e-9 of the diagonal, the topology's default, would leave it open).
+  TopologyOptions topo_options;
+  topo_options.relative_tolerance = std::max(topo_options.relative_tolerance, 1e-2 * tol / diag);
+  const Topology topo = build_topology(model, topo_options);
 
   // The sign of each cell's Jacobian, from its quadrature volume.
   std::vector<int> sign(idx(n_cells), 1);

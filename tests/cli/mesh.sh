@@ -9,6 +9,7 @@
 #   volume to float precision.
 # - The twisted column (4 curved cells) is one shell whose volume is the cells' quadrature volume
 #   up to the tessellation error, at most tolerance x area; a finer tolerance gives a smaller error.
+# - The two balls of fillet_spheres with their fillet ring: 3 closed shells, Euler 2 + 2 + 0.
 # - The primitives scene built into a model: 5 separate solids (box, cylinder, cone, torus,
 #   sphere), Euler characteristic 4 x 2 + 0 (the torus has genus 1).
 # - PLY and OBJ open in Blender (headless) with our vertex and face counts and a colour
@@ -142,6 +143,18 @@ PY
 else
   echo "blender is not installed: the Blender import is skipped (tools/setup.sh installs it)"
 fi
+
+# Two overlapping balls with a fillet ring around their intersection circle: the ring's two cells
+# close onto themselves only to the fit's accuracy, yet the mesh is closed: the balls (genus 0)
+# and the ring (genus 1), 3 parts for admesh.
+"$trivox" build models/fillet_spheres.json -o "$tmp/fillet_spheres.json" > /dev/null
+"$trivox" mesh "$tmp/fillet_spheres.json" -o "$tmp/fs.stl" --json > "$tmp/fs.json"
+"$py" - "$tmp/fs.json" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+assert d["manifold"] and d["shells"] == 3 and d["euler"] == 2 + 2 + 0, d
+PY
+admesh_check "$tmp/fs.stl" 3 "$(json "$tmp/fs.json" 'd["volume"]')"
 
 # Per cell: every cell its own closed shell.
 "$trivox" mesh "$tmp/primitives.json" -o "$tmp/cells.stl" --cells --json > "$tmp/cells.json"

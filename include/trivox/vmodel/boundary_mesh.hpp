@@ -8,7 +8,10 @@
 /// structured grid of triangles; interior V-surfaces (two cells' coinciding faces) are left out,
 /// so a complex of cells glued face to face gives one closed surface. Two faces of the same cell
 /// that coincide (a cell closed onto itself, such as a full ring of the torus primitive, whose
-/// w0 and w1 faces meet) are interior as well and left out. With MeshOptions::per_cell every
+/// w0 and w1 faces meet) are interior as well and left out. The topology is built with the
+/// matching distance 1% of the chordal tolerance (at least its default, 1e-9 of the diagonal):
+/// geometry that close is one at the mesh's resolution, and rings closed by fitting (fillets)
+/// meet themselves only to about 1e-5 of their size. With MeshOptions::per_cell every
 /// cell's own boundary is tessellated instead, glued or not: one closed shell per cell, sharing
 /// no vertex with another cell's.
 ///
