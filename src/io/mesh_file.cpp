@@ -14,6 +14,7 @@
 
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/io/sha256.hpp"
 
 namespace trivox::io {
 
@@ -172,6 +173,20 @@ DWORD unit_3mf(const std::string& units) {
   throw Error("3MF: units \"" + one_line(units) + "\"; expected one of um, mm, cm, m, in, ft");
 }
 
+/// A UUID (RFC 9562 version 8: custom) from the SHA-256 of the mesh and the role: lib3mf would
+/// draw random ones, and the same mesh must give the same file.
+std::string content_uuid(const BoundaryMesh& mesh, const MeshWriteOptions& options, char role) {
+  std::string data(1, role);
+  data += options.name + '\0' + options.units + '\0';
+  data.append(reinterpret_cast<const char*>(mesh.vertices.data()), mesh.vertices.size() * sizeof(mesh.vertices[0]));
+  data.append(reinterpret_cast<const char*>(mesh.triangles.data()), mesh.triangles.size() * sizeof(mesh.triangles[0]));
+  data.append(reinterpret_cast<const char*>(mesh.properties.data()), mesh.properties.size() * sizeof(double));
+  std::string h = sha256_hex(data).substr(0, 32);
+  h[12] = '8';                                              // version
+  h[16] = "89ab"[std::stoi(h.substr(16, 1), nullptr, 16) & 3];  // variant 10
+  return h.substr(0, 8) + '-' + h.substr(8, 4) + '-' + h.substr(12, 4) + '-' + h.substr(16, 4) + '-' + h.substr(20, 12);
+}
+
 std::string encode_3mf(const BoundaryMesh& mesh, const MeshWriteOptions& options) {
   const DWORD unit = unit_3mf(options.units);
   Handle model, object, handler, item, writer;
@@ -210,6 +225,9 @@ std::string encode_3mf(const BoundaryMesh& mesh, const MeshWriteOptions& options
              "setcolorrgb");
   }
   check3mf(NMR::lib3mf_model_addbuilditem(model.p, object.p, nullptr, &item.p), model.p, "addbuilditem");
+  check3mf(NMR::lib3mf_object_setuuidutf8(object.p, content_uuid(mesh, options, 'o').c_str()), object.p, "setuuid");
+  check3mf(NMR::lib3mf_builditem_setuuidutf8(item.p, content_uuid(mesh, options, 'i').c_str()), item.p, "setuuid");
+  check3mf(NMR::lib3mf_model_setbuilduuidutf8(model.p, content_uuid(mesh, options, 'b').c_str()), model.p, "setuuid");
   check3mf(NMR::lib3mf_model_querywriter(model.p, "3mf", &writer.p), model.p, "querywriter");
   Sink sink;
   check3mf(NMR::lib3mf_writer_writetocallback(writer.p, reinterpret_cast<void*>(&sink_write),

@@ -153,6 +153,8 @@ TEST_CASE("mesh files: formats from names, atomic writes, refusals", "[mesh_file
     const std::string bytes = io::read_file(p);
     if (f != io::MeshFormat::threemf) REQUIRE(bytes == io::encode_mesh(mesh, f));
     else REQUIRE(bytes.substr(0, 2) == "PK");  // a zip; its content is read in tests/cli/mesh.sh
+    // The same mesh gives the same bytes (3MF included: no random UUIDs).
+    REQUIRE(io::encode_mesh(mesh, f) == io::encode_mesh(mesh, f));
   }
   // Only the four files: no temporary left behind.
   REQUIRE(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 4);

@@ -18,7 +18,8 @@
 ///  - 3MF: through lib3mf (core specification plus the materials extension): one mesh object
 ///    and one build item, the model's units, and with colour a colour group with every triangle
 ///    carrying its three vertices' colours (p1, p2, p3), the object's default colour that of
-///    vertex 0.
+///    vertex 0. The object's, the build item's and the build's UUIDs are derived from the SHA-256
+///    of the mesh (RFC 9562 version 8), so the same mesh gives the same bytes.
 ///
 /// Every file is encoded in memory and written with write_file_atomically (model_file.hpp):
 /// a temporary name in the same folder, then a rename. Cost: linear in the mesh; memory: the
