@@ -353,7 +353,9 @@ struct Builder {
 
   /// Ruled quad with vertical rulings: q = (U(s), (1 - t) vb(s) + t vt(s)).
   void vertical_quad(const Poly& U, Poly vb, Poly vt, double um, double vm) {
-    const int n = std::max({static_cast<int>(U.size()), static_cast<int>(vb.size()), static_cast<int>(vt.size())}) - 1;
+    // v in its own degree: between two knot lines it is constant in s and the patch is the
+    // Bezier piece itself, of the surface's degrees.
+    const int n = std::max(static_cast<int>(vb.size()), static_cast<int>(vt.size())) - 1;
     vb = bern_elevate(std::move(vb), n);
     vt = bern_elevate(std::move(vt), n);
     emit(in_s(U), ruled(vb, vt), um, vm);

@@ -444,6 +444,9 @@ TEST_CASE("untrim: no loops untrims the whole surface", "[trimmed_surface]") {
   const Surface face = affine_face({0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0, 0});
   const auto un = geom::untrim(TrimmedSurface(face, {}));
   CHECK(un.patches.size() == 6);  // 3 x 2 Bezier pieces
+  // A rectangle between knot lines composes to the biquadratic piece itself.
+  CHECK(un.report.max_order_s == 3);
+  CHECK(un.report.max_order_t == 3);
   CHECK(std::abs(geom::area(un) - 2.0 * 3.0 * 2.0) < 1e-12);  // [0, 2] x [0, 1] scaled by 2 x 3
 }
 
