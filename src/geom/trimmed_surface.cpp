@@ -353,6 +353,10 @@ struct Builder {
 
   /// Ruled quad with vertical rulings: q = (U(s), (1 - t) vb(s) + t vt(s)).
   void vertical_quad(const Poly& U, Poly vb, Poly vt, double um, double vm) {
+    // A horizontal curve (all coefficients equal) is a constant: the patch's degree does not
+    // grow with it.
+    for (Poly* c : {&vb, &vt})
+      if (std::all_of(c->begin(), c->end(), [&](double x) { return x == c->front(); })) c->resize(1);
     // v in its own degree: between two knot lines it is constant in s and the patch is the
     // Bezier piece itself, of the surface's degrees.
     const int n = std::max(static_cast<int>(vb.size()), static_cast<int>(vt.size())) - 1;
