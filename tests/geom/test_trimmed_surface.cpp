@@ -440,6 +440,31 @@ TEST_CASE("untrim: a bicubic surface trimmed by cubic B-spline loops", "[trimmed
   for (std::size_t i = 0; i < un.patches.size(); ++i) CHECK(again.patches[i] == un.patches[i]);
 }
 
+TEST_CASE("untrim: a quarter cylinder trimmed by a cubic loop", "[trimmed_surface]") {
+  // The cubic Bezier quarter circle (1, 0), (1, k), (k, 1), (0, 1) swept along z in [0, 2]:
+  // area element |c'(u)|, so the trimmed area is -(loop integral of |c'(u)| v du).
+  const double k = 0.5522847498;
+  const Surface cyl({KnotVector::bezier(4), KnotVector::bezier(2, 0.0, 2.0)}, 3,
+                    std::vector<double>{1, 0, 0, 1, k, 0, k, 1, 0, 0, 1, 0, 1, 0, 2, 1, k, 2, k, 1, 2, 0, 1, 2});
+  const Curve loop = blob(0.5, 1.0, 0.35, 0.1, 8, true);
+  const auto un = geom::untrim(TrimmedSurface(cyl, {TrimLoop{{loop}}}));
+  double expected = 0.0;
+  const auto r = geom::gauss_legendre(16);
+  const auto dom = loop.domain(0);
+  for (int e = 0; e < 400; ++e) {
+    const double t0 = dom[0] + (dom[1] - dom[0]) * e / 400, t1 = dom[0] + (dom[1] - dom[0]) * (e + 1) / 400;
+    for (std::size_t i = 0; i < r.nodes.size(); ++i) {
+      const auto d = loop.eval_derivatives({0.5 * (t0 + t1) + 0.5 * (t1 - t0) * r.nodes[i]}, 1);
+      const auto c = cyl.eval_derivatives({d[0], 0.0}, 1);  // x y z, x_u y_u z_u, x_v y_v z_v
+      expected -= 0.5 * (t1 - t0) * r.weights[i] * std::hypot(c[3], c[4]) * d[1] * d[2];
+    }
+  }
+  std::printf("quarter cylinder: %lld patches, area %.15g (Green %.15g)\n", static_cast<long long>(un.report.patches),
+              geom::area(un), expected);
+  CHECK(std::abs(geom::area(un) - expected) < 1e-9);
+  CHECK(un.report.max_composition_error < 1e-12);
+}
+
 TEST_CASE("untrim: no loops untrims the whole surface", "[trimmed_surface]") {
   const Surface face = affine_face({0, 0, 0}, {2, 0, 0}, {0, 3, 0}, {0, 0, 0});
   const auto un = geom::untrim(TrimmedSurface(face, {}));
