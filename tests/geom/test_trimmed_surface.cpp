@@ -12,7 +12,10 @@
 // - a bicubic surface trimmed by cubic B-spline loops crossing its knot lines: the patches'
 //   area equals -(loop integral of F du) with F(u, v) = int_0^v |S_u x S_v| dw (Green's theorem,
 //   computed by Gauss quadrature along the loops, independent of any tiling), and each patch is
-//   S(q(s, t)) at random points;
+//   S(q(s, t)) at random points; a cubic quarter cylinder's trimmed area is
+//   -(loop integral of |c'(u)| v du), its area element being |c'(u)|;
+// - a polygon along knot lines and a crescent between quadratic arcs give their areas by the
+//   shoelace formula and by Green's theorem for quadratic Bezier arcs;
 // - refusals: open loop, loop leaving the rectangle, crossing loops, no outer loop, nested
 //   outer loops, orders over the limits, a rational surface.
 #include <catch2/catch.hpp>
