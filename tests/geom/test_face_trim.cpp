@@ -1,0 +1,203 @@
+// Faces cut by curves in their parameter space (geom/face_trim.hpp). Truths:
+// - a planar face S(u, v) = (2u, 3v, 0) has area element 6: a region of parameter area A has area
+//   6 A; a square hole leaves 6 (1 - a^2); a straight chord from (0.25, 0) to (0.75, 1) leaves
+//   6 * 0.5 on its left; a quadratic Bezier chord v = 0.5 + 0.8 u (1 - u) leaves below it
+//   6 (0.5 + 2/3 * 0.2) (a parabolic segment's area is 2/3 base x height);
+// - a cubic B-spline approximation of a circle as a hole: the kept area is 6 (1 - A_c), A_c the
+//   curve's own enclosed area by Green's theorem, 1/2 loop integral (u v' - v u') dt, with Gauss
+//   points exact for the polynomial integrand (independent of the tracing and untrimming);
+// - the regions of any arrangement tile the face: their areas add up to the face's area, also
+//   for a curved (biquadratic) face, with chords, an island and an island inside the island;
+// - the predicate decides: keeping the complement gives the complementary area;
+// - refusals: an open curve ending inside the rectangle (the message names the face), crossing
+//   curves; determinism: two runs give the same loops.
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "trivox/error.hpp"
+#include "trivox/geom/face_trim.hpp"
+#include "trivox/geom/quadrature.hpp"
+#include "trivox/geom/trimmed_surface.hpp"
+
+using namespace trivox;
+using geom::FaceTrimOptions;
+using spline::Curve;
+using spline::KnotVector;
+using spline::Surface;
+
+namespace {
+
+using Pt = std::array<double, 2>;
+
+Surface planar_face() {
+  // S(u, v) = (2u, 3v, 0) on [0, 1]^2, bilinear.
+  return Surface({KnotVector::bezier(2), KnotVector::bezier(2)}, 3,
+                 std::vector<double>{0, 0, 0, 2, 0, 0, 0, 3, 0, 2, 3, 0});
+}
+
+Surface curved_face() {
+  // A biquadratic bump with parameter rectangle [0, 2] x [0, 3].
+  std::vector<double> p;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) p.insert(p.end(), {1.0 * i, 1.5 * j, (i == 1 && j == 1) ? 1.5 : 0.2 * i * j});
+  return Surface({KnotVector::bezier(3, 0.0, 2.0), KnotVector::bezier(3, 0.0, 3.0)}, 3, p);
+}
+
+Curve polyline(const std::vector<Pt>& p) {
+  // A degree-1 B-spline through the points (closed when the last equals the first).
+  std::vector<double> k{0, 0};
+  for (std::size_t i = 1; i + 1 < p.size(); ++i) k.push_back(static_cast<double>(i));
+  k.push_back(static_cast<double>(p.size() - 1));
+  k.push_back(static_cast<double>(p.size() - 1));
+  std::vector<double> c;
+  for (const auto& q : p) c.insert(c.end(), {q[0], q[1]});
+  return Curve({KnotVector(2, k)}, 2, c);
+}
+
+Curve circle_like(Pt centre, double r) {
+  // Clamped cubic B-spline whose first and last control points coincide: a closed curve inside
+  // the circle of radius r on which its control points lie.
+  const int n = 8;
+  std::vector<double> c;
+  const double pi = std::acos(-1.0);
+  for (int i = 0; i <= n; ++i) {
+    const double a = 2 * pi * i / n;
+    c.insert(c.end(), {centre[0] + r * std::cos(a), centre[1] + r * std::sin(a)});
+  }
+  return Curve({KnotVector::uniform(4, n - 2)}, 2, c);
+}
+
+double green_area(const Curve& c) {
+  const auto g = geom::gauss_legendre(8);
+  const auto& kv = c.knots(0);
+  double a = 0;
+  for (std::size_t i = 0; i + 1 < kv.knots().size(); ++i) {
+    const double t0 = kv.knots()[i], t1 = kv.knots()[i + 1];
+    if (!(t1 > t0) || t0 < kv.front() || t1 > kv.back()) continue;
+    for (std::size_t q = 0; q < g.nodes.size(); ++q) {
+      const double t = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * g.nodes[q];
+      const auto d = c.eval_derivatives({t}, 1);  // u, v, u', v'
+      a += 0.5 * (t1 - t0) * g.weights[q] * 0.5 * (d[0] * d[3] - d[1] * d[2]);
+    }
+  }
+  return a;
+}
+
+double total(const std::vector<geom::TrimmedSurface>& s) {
+  double a = 0;
+  for (const auto& t : s) a += geom::area(t);
+  return a;
+}
+
+}  // namespace
+
+TEST_CASE("trim_face: a square hole in a planar face", "[face_trim]") {
+  const double a = 0.4;
+  const Curve sq = polyline({{0.3, 0.3}, {0.3 + a, 0.3}, {0.3 + a, 0.3 + a}, {0.3, 0.3 + a}, {0.3, 0.3}});
+  auto outside = [&](const double* x) {
+    const double u = x[0] / 2, v = x[1] / 3;
+    return !(u > 0.3 && u < 0.3 + a && v > 0.3 && v < 0.3 + a);
+  };
+  const auto regions = geom::face_regions(planar_face(), {sq}, outside);
+  REQUIRE(regions.size() == 2);
+  CHECK(regions[0].kept);
+  CHECK_FALSE(regions[1].kept);
+  const auto kept = geom::trim_face(planar_face(), {sq}, outside);
+  REQUIRE(kept.size() == 1);
+  const double got = total(kept);
+  std::printf("square hole: area %.15g, expected %.15g\n", got, 6 * (1 - a * a));
+  CHECK(std::abs(got - 6 * (1 - a * a)) <= 1e-8 * 6);
+  // The complement.
+  const auto inner = geom::trim_face(planar_face(), {sq}, [&](const double* x) { return !outside(x); });
+  REQUIRE(inner.size() == 1);
+  CHECK(std::abs(total(inner) - 6 * a * a) <= 1e-8 * 6);
+}
+
+TEST_CASE("trim_face: straight and curved chords", "[face_trim]") {
+  const Curve chord = polyline({{0.25, 0.0}, {0.75, 1.0}});
+  auto left = [](const double* x) { return x[0] / 2 < 0.25 + 0.5 * x[1] / 3; };
+  const auto l = geom::trim_face(planar_face(), {chord}, left);
+  REQUIRE(l.size() == 1);
+  CHECK(std::abs(total(l) - 3.0) <= 1e-8 * 6);
+  // The chord reversed gives the same region.
+  const Curve rev = polyline({{0.75, 1.0}, {0.25, 0.0}});
+  CHECK(std::abs(total(geom::trim_face(planar_face(), {rev}, left)) - 3.0) <= 1e-8 * 6);
+
+  const Curve arc({KnotVector::bezier(3)}, 2, std::vector<double>{0, 0.5, 0.5, 0.9, 1, 0.5});
+  auto below = [](const double* x) {
+    const double u = x[0] / 2, v = x[1] / 3;
+    return v < 0.5 + 0.8 * u * (1 - u);
+  };
+  const auto b = geom::trim_face(planar_face(), {arc}, below);
+  REQUIRE(b.size() == 1);
+  const double expected = 6 * (0.5 + 2.0 / 3.0 * 0.2);
+  std::printf("parabolic chord: area %.15g, expected %.15g\n", total(b), expected);
+  CHECK(std::abs(total(b) - expected) <= 1e-8 * 6);
+}
+
+TEST_CASE("trim_face: a cubic circle as a hole, area by Green's theorem", "[face_trim]") {
+  const Curve c = circle_like({0.5, 0.5}, 0.3);
+  const double ac = green_area(c);
+  const double pi = std::acos(-1.0);
+  REQUIRE(ac > 0.7 * pi * 0.09);  // inside its control polygon, itself inside the circle
+  REQUIRE(ac < pi * 0.09);
+  // The classification point of each region lies far from the curve, so the circle of radius
+  // 0.3 around the curve serves as the predicate.
+  auto outside = [](const double* x) { return std::hypot(x[0] / 2 - 0.5, x[1] / 3 - 0.5) > 0.3; };
+  const auto kept = geom::trim_face(planar_face(), {c}, outside);
+  REQUIRE(kept.size() == 1);
+  std::printf("cubic circle hole: area %.15g, expected 6 (1 - %.15g) = %.15g\n", total(kept), ac, 6 * (1 - ac));
+  CHECK(std::abs(total(kept) - 6 * (1 - ac)) <= 1e-8 * 6);
+}
+
+TEST_CASE("trim_face: the regions tile a curved face", "[face_trim]") {
+  const Surface f = curved_face();
+  const std::vector<Curve> cuts{
+      polyline({{0.0, 0.5}, {0.8, 1.2}, {2.0, 0.7}}),       // chord left -> right
+      polyline({{1.5, 3.0}, {1.7, 2.0}, {2.0, 1.8}}),       // chord top -> right, a corner cut
+      circle_like({0.8, 2.0}, 0.5),                         // island
+      circle_like({0.8, 2.0}, 0.2),                         // island inside the island
+  };
+  const auto regions = geom::face_regions(f, cuts, [](const double*) { return true; });
+  REQUIRE(regions.size() == 5);
+  double sum = 0;
+  for (const auto& r : regions) sum += geom::area(r.surface);
+  const double whole = geom::surface_area(f, 16);
+  std::printf("curved face: regions' areas sum %.15g, face area %.15g\n", sum, whole);
+  CHECK(std::abs(sum - whole) <= 1e-8 * whole);
+  // The ring between the islands and the inner disc are the last two regions.
+  CHECK(regions[3].surface.loops().size() == 2);
+  CHECK(regions[4].surface.loops().size() == 1);
+  // Determinism.
+  const auto again = geom::face_regions(f, cuts, [](const double*) { return true; });
+  REQUIRE(again.size() == regions.size());
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    CHECK(again[i].u == regions[i].u);
+    CHECK(again[i].v == regions[i].v);
+    REQUIRE(again[i].surface.loops().size() == regions[i].surface.loops().size());
+    for (std::size_t k = 0; k < regions[i].surface.loops().size(); ++k)
+      CHECK(again[i].surface.loops()[k].pieces == regions[i].surface.loops()[k].pieces);
+  }
+}
+
+TEST_CASE("trim_face: refusals", "[face_trim]") {
+  FaceTrimOptions o;
+  o.face_name = "cell 3, face w+";
+  const Curve dangling = polyline({{0.0, 0.5}, {0.6, 0.5}});
+  try {
+    geom::trim_face(planar_face(), {dangling}, [](const double*) { return true; }, o);
+    FAIL("no error");
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    CHECK(m.find("cell 3, face w+") != std::string::npos);
+    CHECK(m.find("open") != std::string::npos);
+  }
+  const Curve a = polyline({{0.0, 0.5}, {1.0, 0.5}});
+  const Curve b = polyline({{0.5, 0.0}, {0.5, 1.0}});
+  CHECK_THROWS_AS(geom::trim_face(planar_face(), {a, b}, [](const double*) { return true; }, o), Error);
+}
