@@ -117,9 +117,13 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
   const double corner_s[4] = {0.0, W, W + H, 2 * W + H};
   const double perimeter = 2 * (W + H);
 
-  // Polylines, open / closed, validation.
-  std::vector<Poly> polys;
-  std::vector<bool> closed;
+  // Validation, then chains: open curves whose ends meet off the boundary are joined end to end
+  // (intersection curves with several faces of another cell meet at its edges).
+  std::vector<Poly> raw;
+  auto off_boundary = [&](Pt q) {
+    return std::min({std::abs(q[0] - u0), std::abs(q[0] - u1), std::abs(q[1] - v0), std::abs(q[1] - v1)});
+  };
+  auto dist = [](Pt a, Pt b) { return std::hypot(a[0] - b[0], a[1] - b[1]); };
   for (std::size_t i = 0; i < cuts.size(); ++i) {
     const auto& c = cuts[i];
     const std::string who = name + ": cutting curve " + std::to_string(i);
@@ -129,13 +133,81 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
     for (const Pt& q : p)
       if (q[0] < u0 - tol || q[0] > u1 + tol || q[1] < v0 - tol || q[1] > v1 + tol)
         throw Error(who + " leaves the parameter rectangle at (" + fmt(q[0]) + ", " + fmt(q[1]) + ")");
-    const bool cl = std::hypot(p.front()[0] - p.back()[0], p.front()[1] - p.back()[1]) <= tol;
+    raw.push_back(std::move(p));
+  }
+  // chains[k]: (curve, reversed) in order; a curve closed by itself is a chain alone.
+  std::vector<std::vector<std::pair<int, bool>>> chains;
+  {
+    const std::size_t n = cuts.size();
+    std::vector<bool> used(n, false);
+    auto end_of = [&](int i, bool rev, bool last) {
+      const Poly& p = raw[static_cast<std::size_t>(i)];
+      return (last != rev) ? p.back() : p.front();
+    };
+    // Extends a chain at its last end while that end lies off the boundary and meets another
+    // curve's end (the first such curve in input order).
+    auto extend = [&](std::vector<std::pair<int, bool>>& ch) {
+      for (;;) {
+        const Pt e = end_of(ch.back().first, ch.back().second, true);
+        if (dist(e, end_of(ch.front().first, ch.front().second, false)) <= tol) return;  // closed
+        if (off_boundary(e) <= tol) return;
+        bool found = false;
+        for (std::size_t j = 0; j < n && !found; ++j) {
+          if (used[j]) continue;
+          const Poly& q = raw[j];
+          if (dist(q.front(), q.back()) <= tol) continue;
+          if (dist(e, q.front()) <= tol) ch.push_back({static_cast<int>(j), false}), found = true;
+          else if (dist(e, q.back()) <= tol) ch.push_back({static_cast<int>(j), true}), found = true;
+          if (found) used[j] = true;
+        }
+        if (!found) return;
+      }
+    };
+    // Chains starting on the boundary first, then the rest (closed chains of open curves).
+    for (int pass = 0; pass < 2; ++pass)
+      for (std::size_t i = 0; i < n; ++i) {
+        if (used[i]) continue;
+        const Poly& p = raw[i];
+        if (dist(p.front(), p.back()) <= tol) {
+          if (pass == 0) {
+            used[i] = true;
+            chains.push_back({{static_cast<int>(i), false}});
+          }
+          continue;
+        }
+        bool rev = false;
+        if (pass == 0) {
+          if (off_boundary(p.front()) <= tol) rev = false;
+          else if (off_boundary(p.back()) <= tol) rev = true;
+          else continue;
+        }
+        used[i] = true;
+        chains.push_back({{static_cast<int>(i), rev}});
+        extend(chains.back());
+      }
+  }
+  std::vector<Poly> polys;
+  std::vector<bool> closed;
+  std::vector<std::vector<spline::Curve>> chain_pieces;
+  for (const auto& ch : chains) {
+    Poly p;
+    std::vector<spline::Curve> pieces;
+    for (const auto& [i, rev] : ch) {
+      Poly q = raw[static_cast<std::size_t>(i)];
+      if (rev) std::reverse(q.begin(), q.end());
+      if (!p.empty()) p.pop_back();
+      p.insert(p.end(), q.begin(), q.end());
+      pieces.push_back(rev ? spline::reverse(cuts[static_cast<std::size_t>(i)], 0) : cuts[static_cast<std::size_t>(i)]);
+    }
+    const std::string who = name + ": cutting curve " + std::to_string(ch.front().first);
+    const bool cl = dist(p.front(), p.back()) <= tol;
     if (!cl) {
       for (const Pt& q : {p.front(), p.back()}) {
-        const double d = std::min({std::abs(q[0] - u0), std::abs(q[0] - u1), std::abs(q[1] - v0), std::abs(q[1] - v1)});
+        const double d = off_boundary(q);
         if (d > tol)
-          throw Error(who + " is open and its end (" + fmt(q[0]) + ", " + fmt(q[1]) + ") lies " + fmt(d) +
-                      " from the parameter rectangle's boundary; expected a closed curve or ends on the boundary within " + fmt(tol));
+          throw Error(who + (ch.size() > 1 ? " (joined with " + std::to_string(ch.size() - 1) + " more)" : std::string()) +
+                      " is open and its end (" + fmt(q[0]) + ", " + fmt(q[1]) + ") lies " + fmt(d) +
+                      " from the parameter rectangle's boundary and meets no other curve's end; expected a closed curve or ends on the boundary within " + fmt(tol));
       }
     } else {
       p.pop_back();
@@ -143,6 +215,7 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
     }
     polys.push_back(std::move(p));
     closed.push_back(cl);
+    chain_pieces.push_back(std::move(pieces));
   }
   // Crossings between curves and of a curve with itself (segments sharing a point skipped).
   {
@@ -183,7 +256,7 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
   };
 
   std::vector<Event> events;
-  for (std::size_t i = 0; i < cuts.size(); ++i) {
+  for (std::size_t i = 0; i < polys.size(); ++i) {
     if (closed[i]) continue;
     events.push_back({perim(polys[i].front()), static_cast<int>(i), 0, polys[i].front()});
     events.push_back({perim(polys[i].back()), static_cast<int>(i), 1, polys[i].back()});
@@ -235,13 +308,13 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
         const std::size_t next = (k + 1) % ne;
         add_arc(r, events[k], events[next], ne == 1);
         const Event& e = events[next];
-        const auto& c = cuts[static_cast<std::size_t>(e.curve)];
+        const auto& c = chain_pieces[static_cast<std::size_t>(e.curve)];
         const Poly& p = polys[static_cast<std::size_t>(e.curve)];
         if (e.end == 0) {
-          r.outer.pieces.push_back(c);
+          r.outer.pieces.insert(r.outer.pieces.end(), c.begin(), c.end());
           r.outer_poly.insert(r.outer_poly.end(), p.begin(), p.end() - 1);
         } else {
-          r.outer.pieces.push_back(spline::reverse(c, 0));
+          for (auto it = c.rbegin(); it != c.rend(); ++it) r.outer.pieces.push_back(spline::reverse(*it, 0));
           r.outer_poly.insert(r.outer_poly.end(), p.rbegin(), p.rend() - 1);
         }
         k = partner[next];
@@ -257,15 +330,15 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
   std::vector<TrimLoop> ccw;
   std::vector<Poly> ccw_poly;
   std::vector<double> areas;
-  for (std::size_t i = 0; i < cuts.size(); ++i) {
+  for (std::size_t i = 0; i < polys.size(); ++i) {
     if (!closed[i]) continue;
     const double a = signed_area(polys[i]);
     TrimLoop l;
     Poly p = polys[i];
     if (a > 0) {
-      l.pieces.push_back(cuts[i]);
+      l.pieces = chain_pieces[i];
     } else {
-      l.pieces.push_back(spline::reverse(cuts[i], 0));
+      for (auto it = chain_pieces[i].rbegin(); it != chain_pieces[i].rend(); ++it) l.pieces.push_back(spline::reverse(*it, 0));
       std::reverse(p.begin(), p.end());
     }
     closed_ids.push_back(static_cast<int>(i));
@@ -301,7 +374,7 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
         for (const Pt& q2 : ccw_poly[j])
           if ((r = open_region(q2)) >= 0) break;
       }
-      if (r < 0) throw Error(name + ": cannot place closed cutting curve " + std::to_string(closed_ids[j]));
+      if (r < 0) throw Error(name + ": cannot place closed cutting curve " + std::to_string(chains[static_cast<std::size_t>(closed_ids[static_cast<std::size_t>(j)])].front().first));
       regions[static_cast<std::size_t>(r)].holes.push_back(static_cast<int>(j));
     }
   }
@@ -358,7 +431,8 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
     std::vector<TrimLoop> loops{regions[r].outer};
     for (int h : regions[r].holes) {
       TrimLoop l;
-      l.pieces.push_back(spline::reverse(ccw[static_cast<std::size_t>(h)].pieces[0], 0));
+      const auto& pc = ccw[static_cast<std::size_t>(h)].pieces;
+      for (auto it = pc.rbegin(); it != pc.rend(); ++it) l.pieces.push_back(spline::reverse(*it, 0));
       loops.push_back(std::move(l));
     }
     const Pt q = best_p[r];

@@ -8,6 +8,7 @@
 //   points exact for the polynomial integrand (independent of the tracing and untrimming);
 // - the regions of any arrangement tile the face: their areas add up to the face's area, also
 //   for a curved (biquadratic) face, with chords, an island and an island inside the island;
+// - four separate edges of a square, meeting end to end, are joined into one hole;
 // - the predicate decides: keeping the complement gives the complementary area;
 // - refusals: an open curve ending inside the rectangle (the message names the face), crossing
 //   curves; determinism: two runs give the same loops.
@@ -116,6 +117,27 @@ TEST_CASE("trim_face: a square hole in a planar face", "[face_trim]") {
   const auto inner = geom::trim_face(planar_face(), {sq}, [&](const double* x) { return !outside(x); });
   REQUIRE(inner.size() == 1);
   CHECK(std::abs(total(inner) - 6 * a * a) <= 1e-8 * 6);
+}
+
+TEST_CASE("trim_face: a square hole from four separate edges, joined end to end", "[face_trim]") {
+  // The edges in scrambled order and directions, as intersections with the four side faces of a
+  // box through the face would come.
+  const std::vector<Curve> edges{polyline({{0.7, 0.3}, {0.7, 0.7}}), polyline({{0.3, 0.3}, {0.3, 0.7}}),
+                                 polyline({{0.7, 0.7}, {0.3, 0.7}}), polyline({{0.7, 0.3}, {0.3, 0.3}})};
+  auto outside = [](const double* x) {
+    const double u = x[0] / 2, v = x[1] / 3;
+    return !(u > 0.3 && u < 0.7 && v > 0.3 && v < 0.7);
+  };
+  const auto regions = geom::face_regions(planar_face(), edges, outside);
+  REQUIRE(regions.size() == 2);
+  const auto kept = geom::trim_face(planar_face(), edges, outside);
+  REQUIRE(kept.size() == 1);
+  REQUIRE(kept[0].loops().size() == 2);
+  CHECK(kept[0].loops()[1].pieces.size() == 4);
+  std::printf("square hole from four edges: area %.15g, expected %.15g\n", total(kept), 6 * (1 - 0.16));
+  CHECK(std::abs(total(kept) - 6 * (1 - 0.16)) <= 1e-8 * 6);
+  // Three edges leave a dangling chain: refused.
+  CHECK_THROWS_AS(geom::trim_face(planar_face(), {edges[0], edges[1], edges[2]}, outside), Error);
 }
 
 TEST_CASE("trim_face: straight and curved chords", "[face_trim]") {

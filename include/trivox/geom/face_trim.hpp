@@ -9,6 +9,10 @@
 /// every curve and from the boundary), and returns every kept region as its own
 /// geom::TrimmedSurface: outer loop counter-clockwise, holes clockwise.
 ///
+/// Open curves whose ends meet off the boundary (within the tolerance) are first joined end to
+/// end into chains (the intersections of a face with the several faces of another cell meet at
+/// that cell's edges), in input order; a chain that returns to its start is a closed curve.
+///
 /// Regions are traced as follows. Open curves are chords: walking the boundary
 /// counter-clockwise from a chord's end to the next chord end, then along that chord to its
 /// other end, and on, encloses one region on the left. Closed curves are islands: each bounds
@@ -57,7 +61,7 @@ struct FaceRegion {
 /// the rectangle's boundary (traced from the boundary point of smallest perimeter position,
 /// counter-clockwise from (u_min, v_min)), then the inside of each closed curve in input order.
 /// @throws trivox::Error (bad_input), naming options.face_name, for a rational or non-planar
-///         curve, an open curve whose end lies off the boundary, curves crossing, more curves
+///         curve, an open curve (chain) whose end lies off the boundary and meets no other curve's end, curves crossing, more curves
 ///         than max_curves, or a region too thin to hold an interior point
 std::vector<FaceRegion> face_regions(const spline::Surface& face,
                                      const std::vector<spline::Curve>& cuts,
