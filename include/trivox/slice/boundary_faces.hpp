@@ -1,0 +1,61 @@
+/// @file trivox/slice/boundary_faces.hpp
+/// @brief The trimmed boundary faces of a Boolean's piece (a trimmed cell, vmodel/boolean.hpp)
+/// and their areas.
+///
+/// A trimmed cell is the part of its trivariate's image inside every `within` cell and outside
+/// every cell of its `without` lists (Massarwi & Elber 2016, Sec. 4). Its boundary is made of
+/// (a) parts of its own trivariate's six faces, where the conditions admit them, and (b) parts of
+/// the condition cells' faces (the wall of a hole: a subtracted cylinder's face inside a box),
+/// where the point lies inside the cell's trivariate and satisfies every other condition.
+/// Each such face is cut by its intersection curves (geom::intersect_surfaces, recomputed here:
+/// the stored VCell::trim_curves do not say which face cut them) with the faces of the other
+/// trivariates (the cell's own and its direct conditions'), and the cut face is split and
+/// classified by geom::trim_face, membership decided by slice::Locator (exact up to its
+/// tolerance). Only direct conditions are used as cutters: a condition cell that is itself
+/// trimmed is tested exactly, but its own conditions' faces do not cut.
+///
+/// Every boundary face is reported, also faces glued to another piece of the same model (the
+/// interior faces of a union): they are not detected nor flagged. Coplanar (coincident) faces
+/// are not cut (intersect_surfaces reports no curve there) and are classified as a whole.
+///
+/// Cost: 6 x 6 x (1 + C)^2 surface intersections for C direct conditions, then per face the cost
+/// of geom::trim_face, one point location per condition and region, and the untrimming.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "trivox/geom/trimmed_surface.hpp"
+#include "trivox/spline/extract.hpp"
+#include "trivox/vmodel/vmodel.hpp"
+
+namespace trivox::slice {
+
+/// One trimmed face of a piece's boundary.
+struct BoundaryFace {
+  int cell = -1;        ///< the model's cell
+  /// -1: the cell's own trivariate; k >= 0: its k-th direct condition cell (the `within` cells in
+  /// order, then the cells of the `without` lists in order)
+  int source = -1;
+  std::string source_name;  ///< that trivariate's cell name
+  spline::Face face = spline::Face::u0;  ///< which face of that trivariate
+  geom::TrimmedSurface surface;  ///< one kept region (adjacent kept regions are not merged)
+  double area = 0.0;
+};
+
+struct BoundaryFaceOptions {
+  /// Relative tolerance of geom::trim_face (ends on the boundary, chains).
+  double tolerance = 1e-7;
+  /// Absolute tolerance of the surface intersections (model units).
+  double intersection_tolerance = 1e-10;
+};
+
+/// The trimmed boundary faces of `model.cells[cell]`, in order: its own faces u0..w1, then each
+/// condition cell's faces u0..w1; the regions of one face in geom::face_regions order.
+/// @throws trivox::Error (bad_input) for a cell index out of range, and as geom::trim_face
+std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell,
+                                         const BoundaryFaceOptions& options = {});
+
+/// The sum of the faces' areas.
+double boundary_area(const std::vector<BoundaryFace>& faces);
+
+}  // namespace trivox::slice
