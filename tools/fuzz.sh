@@ -19,10 +19,11 @@ for t in "${targets[@]}"; do
   grep -q "^$t " fuzz/seeds.txt || { echo "fuzz: $t: unknown target; expected one of fuzz/seeds.txt" >&2; exit 2; }
 done
 
-tools/sanitize.sh --build-only
+tools/sanitize.sh --build-only --fuzz
 root=$PWD
 build=$(cd "$build" && pwd)
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+# malloc_context_size as in tools/sanitize.sh: the stack depot grows with every new allocation stack.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:malloc_context_size=8}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1}
 mkdir -p "$build/fuzz/findings"
 # The scene reader opens G+Smo files a scene names, relative to the working folder: an empty one.
