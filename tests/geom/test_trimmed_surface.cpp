@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "trivox/error.hpp"
@@ -171,6 +172,41 @@ std::array<double, 3> cross3(std::array<double, 3> a, std::array<double, 3> b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
+/// Where quads of `un` share a side: at per_side - 1 points inside each side of each quad, away
+/// (by `off`) from the trimming polylines, the point of every other quad's patch at the same
+/// domain point. Every such side point must have a neighbour; returns how many were checked and
+/// the largest distance in space.
+std::pair<int, double> neighbour_gap(const geom::Untrimmed& un, const std::vector<std::vector<Pt>>& trims,
+                                     int per_side, double off) {
+  int shared = 0;
+  double gap = 0.0;
+  for (std::size_t i = 0; i < un.domains.size(); ++i)
+    for (int side = 0; side < 4; ++side)
+      for (int j = 1; j < per_side; ++j) {
+        const double r = double(j) / per_side;
+        const std::array<double, 2> st = side == 0 ? std::array<double, 2>{r, 0} : side == 1 ? std::array<double, 2>{1, r}
+                                         : side == 2 ? std::array<double, 2>{r, 1} : std::array<double, 2>{0, r};
+        const auto q = un.domains[i].eval(st);
+        const Pt x{q[0], q[1]};
+        bool on_trim = false;
+        for (const auto& t : trims) on_trim = on_trim || polyline_distance(t, x) < off;
+        if (on_trim) continue;
+        const auto p = un.patches[i].eval(st);
+        int partners = 0;
+        for (std::size_t k = 0; k < un.domains.size(); ++k) {
+          std::array<double, 2> st2;
+          if (k == i || !invert(un.domains[k], x, st2)) continue;
+          const auto p2 = un.patches[k].eval({st2[0], st2[1]});
+          for (int d = 0; d < 3; ++d) gap = std::max(gap, std::abs(p[d] - p2[d]));
+          ++partners;
+        }
+        if (partners == 0) std::printf("side point of quad %zu (side %d, at %g) without a neighbour: (%.17g, %.17g)\n", i, side, r, x[0], x[1]);
+        CHECK(partners >= 1);
+        ++shared;
+      }
+  return {shared, gap};
+}
+
 }  // namespace
 
 TEST_CASE("untrim: a planar face with a polygonal hole", "[trimmed_surface]") {
@@ -250,29 +286,7 @@ TEST_CASE("untrim: neighbouring patches meet along their sides", "[trimmed_surfa
   const Surface face = affine_face({0, 0, 0}, {1, 0.3, 0.2}, {0.1, 1, -0.5}, {1, 1, 1});
   const auto hole = clockwise(hole_polygon);
   const auto un = geom::untrim(TrimmedSurface(face, {polygon_loop(outer_polygon), polygon_loop(hole)}));
-  int shared = 0;
-  double gap = 0.0;
-  for (std::size_t i = 0; i < un.domains.size(); ++i)
-    for (int side = 0; side < 4; ++side)
-      for (int j = 1; j < 10; ++j) {
-        const double r = j / 10.0;
-        const std::array<double, 2> st = side == 0 ? std::array<double, 2>{r, 0} : side == 1 ? std::array<double, 2>{1, r}
-                                         : side == 2 ? std::array<double, 2>{r, 1} : std::array<double, 2>{0, r};
-        const auto q = un.domains[i].eval(st);
-        const Pt x{q[0], q[1]};
-        if (polyline_distance(outer_polygon, x) < 1e-9 || polyline_distance(hole, x) < 1e-9) continue;
-        const auto p = un.patches[i].eval(st);
-        int partners = 0;
-        for (std::size_t k = 0; k < un.domains.size(); ++k) {
-          std::array<double, 2> st2;
-          if (k == i || !invert(un.domains[k], x, st2)) continue;
-          const auto p2 = un.patches[k].eval({st2[0], st2[1]});
-          for (int d = 0; d < 3; ++d) gap = std::max(gap, std::abs(p[d] - p2[d]));
-          ++partners;
-        }
-        CHECK(partners >= 1);
-        ++shared;
-      }
+  const auto [shared, gap] = neighbour_gap(un, {outer_polygon, hole}, 10, 1e-9);
   std::printf("shared side points: %d, largest gap %.3g\n", shared, gap);
   CHECK(shared > 50);
   CHECK(gap < 1e-9);
@@ -410,30 +424,7 @@ TEST_CASE("untrim: a bicubic surface trimmed by cubic B-spline loops", "[trimmed
   CHECK(inside > 100);
   CHECK(outside > 100);
   // Neighbours meet in space.
-  double gap = 0.0;
-  int shared = 0;
-  for (std::size_t i = 0; i < un.domains.size(); ++i)
-    for (int side = 0; side < 4; ++side)
-      for (int j = 1; j < 6; ++j) {
-        const double r = j / 6.0;
-        const std::array<double, 2> st = side == 0 ? std::array<double, 2>{r, 0} : side == 1 ? std::array<double, 2>{1, r}
-                                         : side == 2 ? std::array<double, 2>{r, 1} : std::array<double, 2>{0, r};
-        const auto q = un.domains[i].eval(st);
-        const Pt x{q[0], q[1]};
-        if (polyline_distance(po, x) < 1e-6 || polyline_distance(ph, x) < 1e-6) continue;
-        const auto p = un.patches[i].eval(st);
-        int partners = 0;
-        for (std::size_t k = 0; k < un.domains.size(); ++k) {
-          std::array<double, 2> st2;
-          if (k == i || !invert(un.domains[k], x, st2)) continue;
-          const auto p2 = un.patches[k].eval({st2[0], st2[1]});
-          for (int d = 0; d < 3; ++d) gap = std::max(gap, std::abs(p[d] - p2[d]));
-          ++partners;
-        }
-        if (partners == 0) std::printf("side point of quad %zu (side %d, at %g) without a neighbour: (%.17g, %.17g)\n", i, side, r, x[0], x[1]);
-        CHECK(partners >= 1);
-        ++shared;
-      }
+  const auto [shared, gap] = neighbour_gap(un, {po, ph}, 6, 1e-6);
   std::printf("bicubic: shared side points %d, largest gap %.3g\n", shared, gap);
   CHECK(shared > 20);
   CHECK(gap < 1e-9);
