@@ -5,10 +5,22 @@
 
 #include "trivox/error.hpp"
 #include "trivox/geom/face_trim.hpp"
+#include "trivox/geom/quadrature.hpp"
 #include "trivox/geom/surface_intersection.hpp"
 #include "trivox/slice/locator.hpp"
 
 namespace trivox::slice {
+
+int face_orientation(spline::Face face) noexcept {
+  switch (face) {
+    case spline::Face::u1:
+    case spline::Face::v0:
+    case spline::Face::w1:
+      return 1;
+    default:
+      return -1;
+  }
+}
 
 std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell, const BoundaryFaceOptions& options) {
   if (cell < 0 || cell >= static_cast<int>(model.cells.size()))
@@ -45,6 +57,10 @@ std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell, 
   for (std::size_t k = 0; k < n; ++k)
     for (std::size_t f = 0; f < 6; ++f) faces[k][f] = spline::boundary_face(src[k].volume, spline::all_faces[f]);
 
+  // The side each source's faces bound: its Jacobian's sign, reversed outside a `without` cell.
+  std::vector<int> side(n);
+  for (std::size_t k = 0; k < n; ++k)
+    side[k] = (geom::signed_volume(src[k].volume) < 0 ? -1 : 1) * (is_within[k] ? 1 : -1);
   geom::IntersectionOptions io;
   io.tolerance = options.intersection_tolerance;
   std::vector<BoundaryFace> out;
@@ -64,9 +80,18 @@ std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell, 
                      (k == 0 ? std::string("own") : "condition " + std::to_string(k - 1) + " (" + src[k].name + ")") +
                      " face " + std::string(spline::face_name(spline::all_faces[f]));
       for (auto& ts : geom::trim_face(F, cuts, [&](const double* x) { return admitted(k, x); }, fo)) {
-        BoundaryFace b{cell, static_cast<int>(k) - 1, src[k].name, spline::all_faces[f], std::move(ts), 0.0};
-        b.area = geom::area(b.surface);
-        out.push_back(std::move(b));
+        geom::Untrimmed patches = geom::untrim(ts);
+        const double a = geom::area(patches);
+        out.push_back({.cell = cell,
+                       .source = static_cast<int>(k) - 1,
+                       .source_name = src[k].name,
+                       .face = spline::all_faces[f],
+                       .surface = std::move(ts),
+                       .area = a,
+                       .orientation = face_orientation(spline::all_faces[f]) * side[k],
+                       .patches = std::move(patches),
+                       .glued = false,
+                       .glued_to = -1});
       }
     }
   return out;

@@ -15,8 +15,15 @@
 /// trimmed is tested exactly, but its own conditions' faces do not cut.
 ///
 /// Every boundary face is reported, also faces glued to another piece of the same model (the
-/// interior faces of a union): they are not detected nor flagged. Coplanar (coincident) faces
-/// are not cut (intersect_surfaces reports no curve there) and are classified as a whole.
+/// interior faces of a union); slice::model_boundary (model_boundary.hpp) flags those. Coplanar
+/// (coincident) faces are not cut (intersect_surfaces reports no curve there) and are classified
+/// as a whole.
+///
+/// Each face carries its orientation: whether the piece's outward normal is S_u x S_v of the
+/// face's surface or its opposite (face_orientation below, times the sign of the source
+/// trivariate's Jacobian determinant, reversed for a `without` cell's face: the piece lies
+/// outside that cell), and its untrimmed patches (geom::untrim), from which its area and the
+/// piece's measures (piece_measures.hpp) are integrated.
 ///
 /// Cost: 6 x 6 x (1 + C)^2 surface intersections for C direct conditions, then per face the cost
 /// of geom::trim_face, one point location per condition and region, and the untrimming.
@@ -40,7 +47,25 @@ struct BoundaryFace {
   spline::Face face = spline::Face::u0;  ///< which face of that trivariate
   geom::TrimmedSurface surface;  ///< one kept region (adjacent kept regions are not merged)
   double area = 0.0;
+  /// +1 when the piece's outward normal points along S_u x S_v of `surface`, -1 when against:
+  /// face_orientation(face) x the sign of the source trivariate's Jacobian determinant
+  /// (geom::signed_volume), x -1 for the face of a `without` cell.
+  int orientation = 1;
+  /// geom::untrim(surface): Bezier patches tiling the region, with S's orientation.
+  geom::Untrimmed patches;
+  /// Set by slice::model_boundary only (false and -1 here): `glued` when the point just outside
+  /// the face (along the outward normal, at the middle of every patch) lies in another cell of
+  /// the model, so the face is interior to the model; `glued_to` the cell found there at the
+  /// first patch that found one (-1: none). A face with glued_to >= 0 and !glued is partly glued.
+  bool glued = false;
+  int glued_to = -1;
 };
+
+/// The side of a right-handed trivariate's face that S_u x S_v of spline::boundary_face points
+/// to: +1 outward (u1, v0, w1), -1 inward (u0, v1, w0). With X_u, X_v, X_w the trivariate's
+/// partials and det J = X_u . (X_v x X_w) > 0: the u faces have S_u x S_v = X_v x X_w (along
+/// +X_u), the v faces X_u x X_w (along -X_v), the w faces X_u x X_v (along +X_w).
+int face_orientation(spline::Face face) noexcept;
 
 struct BoundaryFaceOptions {
   /// Relative tolerance of geom::trim_face (ends on the boundary, chains).

@@ -1,0 +1,214 @@
+#include "trivox/slice/piece_measures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "trivox/error.hpp"
+#include "trivox/geom/quadrature.hpp"
+
+namespace trivox::slice {
+
+namespace {
+
+/// Sums over the oriented patches, about the point c.
+struct Sums {
+  std::array<double, 3> normal{};  ///< int n_i dA
+  std::array<double, 3> volume{};  ///< int (x_i - c_i) n_i dA
+  std::array<double, 3> moment{};  ///< 1/2 int (x_i - c_i)^2 n_i dA
+};
+
+/// The distinct knot spans of a knot vector.
+std::vector<std::array<double, 2>> spans(const spline::KnotVector& k) {
+  std::vector<std::array<double, 2>> out;
+  const auto& t = k.knots();
+  for (std::size_t i = 0; i + 1 < t.size(); ++i)
+    if (t[i + 1] > t[i]) out.push_back({t[i], t[i + 1]});
+  return out;
+}
+
+void integrate(const spline::Surface& p, int sign, const std::array<double, 3>& c, Sums& s) {
+  const auto ord = p.orders();
+  const geom::GaussRule gs = geom::gauss_legendre(2 * ord[0]), gt = geom::gauss_legendre(2 * ord[1]);
+  const int dim = p.dim();
+  std::vector<double> d(static_cast<std::size_t>(3 * dim));
+  for (const auto& a : spans(p.knots(0)))
+    for (const auto& b : spans(p.knots(1))) {
+      const double hs = 0.5 * (a[1] - a[0]), ht = 0.5 * (b[1] - b[0]);
+      for (std::size_t i = 0; i < gs.nodes.size(); ++i)
+        for (std::size_t j = 0; j < gt.nodes.size(); ++j) {
+          p.eval_derivatives({a[0] + hs * (1 + gs.nodes[i]), b[0] + ht * (1 + gt.nodes[j])}, 1, d.data());
+          const double* x = d.data();
+          const double* xs = x + dim;
+          const double* xt = xs + dim;
+          const double w = sign * gs.weights[i] * gt.weights[j] * hs * ht;
+          const double n[3] = {xs[1] * xt[2] - xs[2] * xt[1], xs[2] * xt[0] - xs[0] * xt[2], xs[0] * xt[1] - xs[1] * xt[0]};
+          for (std::size_t k = 0; k < 3; ++k) {
+            const double y = x[k] - c[k];
+            s.normal[k] += w * n[k];
+            s.volume[k] += w * y * n[k];
+            s.moment[k] += w * 0.5 * y * y * n[k];
+          }
+        }
+    }
+}
+
+/// A Bezier patch's coefficients of one coordinate: ns x nt, s fastest.
+struct Grid {
+  int ns = 0, nt = 0;
+  std::vector<double> a;
+  double at(int i, int j) const { return a[static_cast<std::size_t>(i + ns * j)]; }
+};
+
+/// Halves g at 1/2 in direction dir by de Casteljau.
+std::pair<Grid, Grid> halve(const Grid& g, int dir) {
+  Grid lo = g, hi = g;
+  const int n = dir == 0 ? g.ns : g.nt, m = dir == 0 ? g.nt : g.ns;
+  std::vector<double> b(static_cast<std::size_t>(n));
+  for (int r = 0; r < m; ++r) {
+    auto idx = [&](int k) { return static_cast<std::size_t>(dir == 0 ? k + g.ns * r : r + g.ns * k); };
+    for (int k = 0; k < n; ++k) b[static_cast<std::size_t>(k)] = g.a[idx(k)];
+    for (int level = 0; level < n; ++level) {
+      lo.a[idx(level)] = b[0];
+      hi.a[idx(n - 1 - level)] = b[static_cast<std::size_t>(n - 1 - level)];
+      for (int k = 0; k + 1 < n - level; ++k)
+        b[static_cast<std::size_t>(k)] = 0.5 * (b[static_cast<std::size_t>(k)] + b[static_cast<std::size_t>(k + 1)]);
+    }
+  }
+  return {std::move(lo), std::move(hi)};
+}
+
+/// Raises `best` to the maximum of the patch g within tol (branch and bound); false when the
+/// budget ran out (best then also holds the remaining coefficient bounds).
+bool patch_max(const Grid& g, double tol, int budget, double& best) {
+  std::vector<Grid> stack{g};
+  double bound = -std::numeric_limits<double>::infinity();
+  bool tight = true;
+  while (!stack.empty()) {
+    Grid h = std::move(stack.back());
+    stack.pop_back();
+    const double m = *std::max_element(h.a.begin(), h.a.end());
+    if (m <= best + tol) continue;
+    best = std::max({best, h.at(0, 0), h.at(h.ns - 1, 0), h.at(0, h.nt - 1), h.at(h.ns - 1, h.nt - 1)});
+    if (m <= best + tol) continue;
+    if (budget-- <= 0) {
+      bound = std::max(bound, m);
+      tight = false;
+      continue;
+    }
+    // Split across the direction along which the coefficients vary most.
+    double vs = 0, vt = 0;
+    for (int j = 0; j < h.nt; ++j)
+      for (int i = 0; i + 1 < h.ns; ++i) vs = std::max(vs, std::abs(h.at(i + 1, j) - h.at(i, j)));
+    for (int j = 0; j + 1 < h.nt; ++j)
+      for (int i = 0; i < h.ns; ++i) vt = std::max(vt, std::abs(h.at(i, j + 1) - h.at(i, j)));
+    auto [lo, hi] = halve(h, vs >= vt ? 0 : 1);
+    stack.push_back(std::move(lo));
+    stack.push_back(std::move(hi));
+  }
+  best = std::max(best, bound);
+  return tight;
+}
+
+void check_polynomial(const vmodel::VCell& c, const std::string& what) {
+  if (c.volume.rational())
+    throw Error("piece_measures: " + what + " '" + c.name +
+                    "' is rational; expected polynomial trivariates (untrimming composes polynomial surfaces)",
+                ErrorKind::failed);
+}
+
+}  // namespace
+
+PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceMeasureOptions& options) {
+  if (cell < 0 || cell >= static_cast<int>(model.cells.size()))
+    throw Error("piece_measures: cell " + std::to_string(cell) + " out of range; the model has " +
+                std::to_string(model.cells.size()) + " cells");
+  // Refuse rational sources before the intersections (geom::TrimmedSurface would, later).
+  const vmodel::VCell& c = model.cells[static_cast<std::size_t>(cell)];
+  check_polynomial(c, "cell");
+  for (const auto& w : c.within) check_polynomial(w, "condition");
+  for (const auto& list : c.without)
+    for (const auto& w : list) check_polynomial(w, "condition");
+  return piece_measures(boundary_faces(model, cell, options.faces), cell, options);
+}
+
+PieceMeasures piece_measures(const std::vector<BoundaryFace>& faces, int cell, const PieceMeasureOptions& options) {
+  PieceMeasures r;
+  r.cell = cell;
+  r.faces = static_cast<int>(faces.size());
+  if (faces.empty()) return r;
+  r.empty = false;
+  // The patches' control boxes: the centre c and the diagonal.
+  std::array<double, 3> lo, hi;
+  lo.fill(std::numeric_limits<double>::infinity());
+  hi.fill(-std::numeric_limits<double>::infinity());
+  for (const auto& f : faces)
+    for (const auto& p : f.patches.patches) {
+      ++r.patches;
+      const auto pts = p.points();
+      for (std::size_t q = 0; q < pts.size(); q += static_cast<std::size_t>(p.dim()))
+        for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], pts[q + k]), hi[k] = std::max(hi[k], pts[q + k]);
+    }
+  if (r.patches == 0) throw Error("piece_measures: cell " + std::to_string(cell) + ": boundary faces without patches", ErrorKind::failed);
+  std::array<double, 3> c;
+  double diag = 0;
+  for (std::size_t k = 0; k < 3; ++k) c[k] = 0.5 * (lo[k] + hi[k]), diag += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+  diag = std::sqrt(diag);
+
+  Sums s;
+  for (const auto& f : faces) {
+    r.area += f.area;
+    for (const auto& p : f.patches.patches) integrate(p, f.orientation, c, s);
+  }
+  r.volume = (s.volume[0] + s.volume[1] + s.volume[2]) / 3;
+  r.closure = std::hypot(s.normal[0], s.normal[1], s.normal[2]) / r.area;
+  for (std::size_t k = 0; k < 3; ++k) r.spread = std::max(r.spread, std::abs(s.volume[k] - r.volume) / (r.area * diag));
+  const std::string where = "piece_measures: cell " + std::to_string(cell);
+  auto fig = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g", v);
+    return std::string(b);
+  };
+  if (!(r.closure <= options.check_tolerance) || !(r.spread <= options.check_tolerance))
+    throw Error(where + ": the boundary faces do not close (|int n dA| / area " + fig(r.closure) +
+                    ", volumes by x, y, z differ by " + fig(r.spread) + " of area x diagonal); expected at most " +
+                    fig(options.check_tolerance),
+                ErrorKind::failed);
+  if (!(r.volume > 0))
+    throw Error(where + ": the boundary encloses volume " + fig(r.volume) + "; expected a positive volume (outward faces)",
+                ErrorKind::failed);
+  for (std::size_t k = 0; k < 3; ++k) r.centroid[k] = c[k] + s.moment[k] / r.volume;
+
+  // The tight box: per coordinate and side, branch and bound over every patch, starting from
+  // the best corner of all patches so that most patches are discarded at once.
+  const double tol = options.bbox_tolerance * diag;
+  for (std::size_t k = 0; k < 3; ++k)
+    for (int side = 0; side < 2; ++side) {
+      const double sg = side ? 1.0 : -1.0;  // maximise sg * x_k
+      std::vector<Grid> grids;
+      double best = -std::numeric_limits<double>::infinity();
+      for (const auto& f : faces)
+        for (const auto& p : f.patches.patches) {
+          Grid g{p.count(0), p.count(1), {}};
+          const auto pts = p.points();
+          for (std::size_t q = 0; q < pts.size(); q += static_cast<std::size_t>(p.dim())) g.a.push_back(sg * pts[q + k]);
+          best = std::max({best, g.at(0, 0), g.at(g.ns - 1, 0), g.at(0, g.nt - 1), g.at(g.ns - 1, g.nt - 1)});
+          // A patch of several spans (not what untrim makes): its coefficients bound it, but its
+          // corner coefficients need not lie on it, so take the conservative bound.
+          if (p.count(0) != p.orders()[0] || p.count(1) != p.orders()[1]) {
+            g.a = {*std::max_element(g.a.begin(), g.a.end())};
+            g.ns = g.nt = 1;
+            r.bbox_tight = false;
+          }
+          grids.push_back(std::move(g));
+        }
+      for (const auto& g : grids) r.bbox_tight = patch_max(g, tol, options.bbox_budget, best) && r.bbox_tight;
+      r.bbox[static_cast<std::size_t>(side)][k] = sg * best;
+    }
+  return r;
+}
+
+}  // namespace trivox::slice
