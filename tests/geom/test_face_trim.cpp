@@ -10,8 +10,17 @@
 //   for a curved (biquadratic) face, with chords, an island and an island inside the island;
 // - four separate edges of a square, meeting end to end, are joined into one hole;
 // - the predicate decides: keeping the complement gives the complementary area;
-// - refusals: an open curve ending inside the rectangle (the message names the face), crossing
-//   curves; determinism: two runs give the same loops.
+// - arrangements with crossings and junctions: two crossing chords (a plus sign) leave four
+//   rectangles; a stem ending on a parabola's apex (a T) leaves the parabolic areas
+//   1 - (0.5 + 2/3 0.2) above and 0.25 + 0.8/12 on each side below; three segments meeting end to
+//   end at an interior point (a Y) leave three polygons of shoelace areas; a circle of four
+//   cubic arcs crossed by a line through its centre, symmetric about it, leaves two half-discs
+//   of A_c / 2 (A_c by Green's theorem on the arcs) and 0.5 - A_c / 2 outside; in every case the
+//   regions' areas add up to the face's to 1e-12;
+// - a repeated curve and curves along the boundary change nothing;
+// - refusals: an open curve ending inside the rectangle (the message names the face), a curve
+//   crossing another and then ending in the open, an end 1e-3 short of the curve it should
+//   meet; determinism: two runs give the same loops.
 #include <catch2/catch.hpp>
 
 #include <array>
@@ -219,7 +228,136 @@ TEST_CASE("trim_face: refusals", "[face_trim]") {
     CHECK(m.find("cell 3, face w+") != std::string::npos);
     CHECK(m.find("open") != std::string::npos);
   }
+  // A curve that crosses another and then ends in the open dangles.
   const Curve a = polyline({{0.0, 0.5}, {1.0, 0.5}});
-  const Curve b = polyline({{0.5, 0.0}, {0.5, 1.0}});
-  CHECK_THROWS_AS(geom::trim_face(planar_face(), {a, b}, [](const double*) { return true; }, o), Error);
+  const Curve b = polyline({{0.5, 0.0}, {0.5, 0.8}});
+  try {
+    geom::trim_face(planar_face(), {a, b}, [](const double*) { return true; }, o);
+    FAIL("no error");
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    CHECK(m.find("cutting curve 1 is open") != std::string::npos);
+  }
+  // A stem stopping 1e-3 short of the bar meets nothing either.
+  const Curve short_stem = polyline({{0.5, 0.0}, {0.5, 0.499}});
+  CHECK_THROWS_AS(geom::trim_face(planar_face(), {a, short_stem}, [](const double*) { return true; }, o), Error);
+}
+
+namespace {
+
+/// Checks each region's area against the expected parameter area (times the area element 6) of
+/// the region holding its interior point, and that the areas add up to the face's 6.
+void check_regions(const std::vector<geom::FaceRegion>& regions, double (*expected)(double u, double v), const char* what) {
+  double sum = 0;
+  for (const auto& r : regions) {
+    const double a = geom::area(r.surface), e = 6 * expected(r.u, r.v);
+    std::printf("%s: region at (%.4f, %.4f): area %.15g, expected %.15g\n", what, r.u, r.v, a, e);
+    CHECK(std::abs(a - e) <= 1e-12 * 6);
+    sum += a;
+  }
+  std::printf("%s: %zu regions, areas sum %.17g (face 6)\n", what, regions.size(), sum);
+  CHECK(std::abs(sum - 6) <= 1e-12 * 6);
+}
+
+auto all = [](const double*) { return true; };
+
+/// The cubic Bezier arc of radius r about c from angle a0 through 90 degrees (k = 4/3 tan(pi/8)).
+Curve quarter(Pt c, double r, double a0) {
+  const double a1 = a0 + std::acos(-1.0) / 2, k = 4.0 / 3.0 * std::tan(std::acos(-1.0) / 8);
+  return Curve({KnotVector::bezier(4)}, 2,
+               std::vector<double>{c[0] + r * std::cos(a0), c[1] + r * std::sin(a0),
+                                   c[0] + r * std::cos(a0) - k * r * std::sin(a0), c[1] + r * std::sin(a0) + k * r * std::cos(a0),
+                                   c[0] + r * std::cos(a1) + k * r * std::sin(a1), c[1] + r * std::sin(a1) - k * r * std::cos(a1),
+                                   c[0] + r * std::cos(a1), c[1] + r * std::sin(a1)});
+}
+
+}  // namespace
+
+TEST_CASE("trim_face: two crossing chords, a plus sign, give four rectangles", "[face_trim]") {
+  // u = 0.3 and v = 0.6 cross inside their polyline segments; u = 0.25 and v = 0.625 cross at
+  // a polyline point of both (16 samples per span).
+  {
+    const std::vector<Curve> plus{polyline({{0.3, 0.0}, {0.3, 1.0}}), polyline({{1.0, 0.6}, {0.0, 0.6}})};
+    const auto regions = geom::face_regions(planar_face(), plus, all);
+    REQUIRE(regions.size() == 4);
+    check_regions(regions, [](double u, double v) { return (u < 0.3 ? 0.3 : 0.7) * (v < 0.6 ? 0.6 : 0.4); }, "plus");
+  }
+  {
+    const std::vector<Curve> plus{polyline({{0.25, 0.0}, {0.25, 1.0}}), polyline({{0.0, 0.625}, {1.0, 0.625}})};
+    const auto regions = geom::face_regions(planar_face(), plus, all);
+    REQUIRE(regions.size() == 4);
+    check_regions(regions, [](double u, double v) { return (u < 0.25 ? 0.25 : 0.75) * (v < 0.625 ? 0.625 : 0.375); }, "plus at samples");
+    // Keeping the lower left quarter only.
+    const auto kept = geom::trim_face(planar_face(), plus, [](const double* x) { return x[0] / 2 < 0.25 && x[1] / 3 < 0.625; });
+    REQUIRE(kept.size() == 1);
+    CHECK(std::abs(total(kept) - 6 * 0.25 * 0.625) <= 1e-12 * 6);
+  }
+}
+
+TEST_CASE("trim_face: T and Y junctions", "[face_trim]") {
+  // T: the parabola v = 0.5 + 0.8 u (1 - u) (a quadratic Bezier chord) and a stem u = 0.5 from
+  // the bottom up to the parabola's apex (0.5, 0.7), an interior point of the parabola. Above:
+  // 1 - (0.5 + 2/3 0.2); each side below: int_0^0.5 (0.5 + 0.8 u (1 - u)) du = 0.25 + 0.8/12.
+  const Curve bar({KnotVector::bezier(3)}, 2, std::vector<double>{0, 0.5, 0.5, 0.9, 1, 0.5});
+  const Curve stem = polyline({{0.5, 0.0}, {0.5, 0.7}});
+  for (int order = 0; order < 2; ++order) {
+    const std::vector<Curve> t = order ? std::vector<Curve>{stem, bar} : std::vector<Curve>{bar, stem};
+    const auto regions = geom::face_regions(planar_face(), t, all);
+    REQUIRE(regions.size() == 3);
+    check_regions(regions, [](double u, double v) { return v > 0.5 + 0.8 * u * (1 - u) ? 1 - (0.5 + 2.0 / 3 * 0.2) : 0.25 + 0.8 / 12; }, "T");
+  }
+  // Y: three segments from the boundary points (0.4, 1), (0, 0), (1, 0.2) meeting end to end at
+  // P = (0.4, 0.5); each region's area by the shoelace formula of its polygon.
+  const std::vector<Curve> y{polyline({{0.4, 0.5}, {0.4, 1.0}}), polyline({{0.0, 0.0}, {0.4, 0.5}}), polyline({{0.4, 0.5}, {1.0, 0.2}})};
+  const auto regions = geom::face_regions(planar_face(), y, all);
+  REQUIRE(regions.size() == 3);
+  check_regions(regions, [](double u, double v) {
+    auto shoelace = [](std::vector<Pt> p) {
+      double a = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) a += p[i][0] * p[(i + 1) % p.size()][1] - p[(i + 1) % p.size()][0] * p[i][1];
+      return 0.5 * a;
+    };
+    const bool right = (u - 0.4) * 0.3 + (v - 0.5) * 0.6 > 0 && u > 0.4;  // above the segment to (1, 0.2), right of u = 0.4
+    const bool lower = !right && (u - 0.4) * 0.5 - (v - 0.5) * 0.4 > 0;  // below the segment from (0, 0)
+    if (right) return shoelace({{0.4, 0.5}, {1, 0.2}, {1, 1}, {0.4, 1}});
+    if (lower) return shoelace({{0, 0}, {1, 0}, {1, 0.2}, {0.4, 0.5}});
+    return shoelace({{0, 0}, {0.4, 0.5}, {0.4, 1}, {0, 1}});
+  }, "Y");
+}
+
+TEST_CASE("trim_face: a circle of four arcs crossed by a line", "[face_trim]") {
+  // Four cubic arcs of radius 0.3 about (0.5, 0.5), given as separate curves, and the chord
+  // v = 0.5. The arcs are symmetric about that line, so each half-disc is A_c / 2, A_c the
+  // arcs' area by Green's theorem; the parts above and below outside the circle 0.5 - A_c / 2.
+  // First the arcs start at 45 degrees (the line crosses two arcs inside), then at 0 degrees
+  // (the line passes through the points where arcs meet).
+  const double pi = std::acos(-1.0);
+  for (double a0 : {pi / 4, 0.0}) {
+    std::vector<Curve> cuts{polyline({{0.0, 0.5}, {1.0, 0.5}})};
+    double ac = 0;
+    for (int q = 0; q < 4; ++q) {
+      cuts.push_back(quarter({0.5, 0.5}, 0.3, a0 + q * pi / 2));
+      ac += green_area(cuts.back());
+    }
+    REQUIRE(std::abs(ac - pi * 0.09) < 1e-3);
+    const auto regions = geom::face_regions(planar_face(), cuts, all);
+    REQUIRE(regions.size() == 4);
+    static double half;
+    half = ac / 2;
+    check_regions(regions, [](double u, double v) { return std::hypot(u - 0.5, v - 0.5) < 0.3 ? half : 0.5 - half; },
+                  a0 > 0 ? "circle crossed inside arcs" : "circle crossed at arc ends");
+  }
+}
+
+TEST_CASE("trim_face: repeated curves and curves along the boundary add nothing", "[face_trim]") {
+  // The same square's edges twice (once reversed), a curve along the bottom side and one along
+  // the right side: still a square hole, 6 (1 - 0.16).
+  const std::vector<Curve> cuts{polyline({{0.3, 0.3}, {0.7, 0.3}, {0.7, 0.7}, {0.3, 0.7}, {0.3, 0.3}}),
+                                polyline({{0.0, 0.0}, {0.6, 0.0}}),
+                                polyline({{0.3, 0.3}, {0.3, 0.7}, {0.7, 0.7}, {0.7, 0.3}, {0.3, 0.3}}),
+                                polyline({{1.0, 0.1}, {1.0, 0.9}}),
+                                polyline({{0.7, 0.3}, {0.7, 0.7}})};
+  const auto regions = geom::face_regions(planar_face(), cuts, all);
+  REQUIRE(regions.size() == 2);
+  check_regions(regions, [](double u, double v) { return (u > 0.3 && u < 0.7 && v > 0.3 && v < 0.7) ? 0.16 : 0.84; }, "repeated");
 }
