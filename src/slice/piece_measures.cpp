@@ -7,8 +7,11 @@
 #include <string>
 #include <utility>
 
+#include "patch_quadrature.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/quadrature.hpp"
+#include "trivox/slice/locator.hpp"
+#include "trivox/spline/extract.hpp"
 
 namespace trivox::slice {
 
@@ -21,39 +24,22 @@ struct Sums {
   std::array<double, 3> moment{};  ///< 1/2 int (x_i - c_i)^2 n_i dA
 };
 
-/// The distinct knot spans of a knot vector.
-std::vector<std::array<double, 2>> spans(const spline::KnotVector& k) {
-  std::vector<std::array<double, 2>> out;
-  const auto& t = k.knots();
-  for (std::size_t i = 0; i + 1 < t.size(); ++i)
-    if (t[i + 1] > t[i]) out.push_back({t[i], t[i + 1]});
-  return out;
-}
-
-void integrate(const spline::Surface& p, int sign, const std::array<double, 3>& c, Sums& s) {
-  const auto ord = p.orders();
-  const geom::GaussRule gs = geom::gauss_legendre(2 * ord[0]), gt = geom::gauss_legendre(2 * ord[1]);
-  const int dim = p.dim();
-  std::vector<double> d(static_cast<std::size_t>(3 * dim));
-  for (const auto& a : spans(p.knots(0)))
-    for (const auto& b : spans(p.knots(1))) {
-      const double hs = 0.5 * (a[1] - a[0]), ht = 0.5 * (b[1] - b[0]);
-      for (std::size_t i = 0; i < gs.nodes.size(); ++i)
-        for (std::size_t j = 0; j < gt.nodes.size(); ++j) {
-          p.eval_derivatives({a[0] + hs * (1 + gs.nodes[i]), b[0] + ht * (1 + gt.nodes[j])}, 1, d.data());
-          const double* x = d.data();
-          const double* xs = x + dim;
-          const double* xt = xs + dim;
-          const double w = sign * gs.weights[i] * gt.weights[j] * hs * ht;
-          const double n[3] = {xs[1] * xt[2] - xs[2] * xt[1], xs[2] * xt[0] - xs[0] * xt[2], xs[0] * xt[1] - xs[1] * xt[0]};
-          for (std::size_t k = 0; k < 3; ++k) {
-            const double y = x[k] - c[k];
-            s.normal[k] += w * n[k];
-            s.volume[k] += w * y * n[k];
-            s.moment[k] += w * 0.5 * y * y * n[k];
-          }
-        }
+/// Adds a patch's integrands at its Gauss points, 2 x order per direction: x_i^2 n_i has
+/// degree 4p - 1 in a direction of degree p, which 2p + 2 points integrate exactly.
+void integrate(const spline::Surface& p, int sign, const std::array<double, 3>& c, detail::PatchRules& rules,
+               std::vector<detail::PatchPoint>& pts, Sums& s) {
+  detail::patch_points(p, [](int order) { return 2 * order; }, rules, pts);
+  for (const auto& q : pts) {
+    const auto &xs = q.xs, &xt = q.xt;
+    const double n[3] = {xs[1] * xt[2] - xs[2] * xt[1], xs[2] * xt[0] - xs[0] * xt[2], xs[0] * xt[1] - xs[1] * xt[0]};
+    const double w = sign * q.w;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double y = q.x[k] - c[k];
+      s.normal[k] += w * n[k];
+      s.volume[k] += w * y * n[k];
+      s.moment[k] += w * 0.5 * y * y * n[k];
     }
+  }
 }
 
 /// A Bezier patch's coefficients of one coordinate: ns x nt, s fastest.
@@ -120,6 +106,54 @@ void check_polynomial(const vmodel::VCell& c, const std::string& what) {
                 ErrorKind::failed);
 }
 
+/// A planar face: its unit normal and offset (n . x = d for every control point within eps).
+struct Plane {
+  bool planar = false;
+  std::array<double, 3> n{};
+  double d = 0;
+  std::array<std::array<double, 3>, 2> box{};
+};
+
+Plane plane_of(const spline::Surface& f, double eps) {
+  Plane pl;
+  const auto pts = f.points();
+  const std::size_t dim = static_cast<std::size_t>(f.dim()), m = pts.size() / dim;
+  auto P = [&](std::size_t i) { return std::array<double, 3>{pts[i * dim], pts[i * dim + 1], pts[i * dim + 2]}; };
+  for (std::size_t k = 0; k < 3; ++k) pl.box[0][k] = pl.box[1][k] = pts[k];
+  for (std::size_t i = 0; i < m; ++i)
+    for (std::size_t k = 0; k < 3; ++k)
+      pl.box[0][k] = std::min(pl.box[0][k], P(i)[k]), pl.box[1][k] = std::max(pl.box[1][k], P(i)[k]);
+  // The normal from the control net's corners (the face's corners).
+  const auto c = f.counts();
+  const auto a = P(0), b = P(static_cast<std::size_t>(c[0] - 1)), e = P(static_cast<std::size_t>(c[0] * (c[1] - 1))),
+             g = P(m - 1);
+  const std::array<double, 3> u{g[0] - a[0], g[1] - a[1], g[2] - a[2]}, v{e[0] - b[0], e[1] - b[1], e[2] - b[2]};
+  std::array<double, 3> n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double len = std::hypot(n[0], n[1], n[2]);
+  if (!(len > 0)) return pl;
+  for (auto& x : n) x /= len;
+  pl.n = n;
+  pl.d = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+  for (std::size_t i = 0; i < m; ++i) {
+    const auto x = P(i);
+    if (std::abs(n[0] * x[0] + n[1] * x[1] + n[2] * x[2] - pl.d) > eps) return pl;
+  }
+  pl.planar = true;
+  return pl;
+}
+
+/// Two planar faces on one plane whose boxes overlap with positive extent in two directions:
+/// coincident regions, which boundary_faces does not cut.
+bool coincide(const Plane& p, const Plane& q, double eps) {
+  if (!p.planar || !q.planar) return false;
+  const double dot = p.n[0] * q.n[0] + p.n[1] * q.n[1] + p.n[2] * q.n[2];
+  if (std::abs(std::abs(dot) - 1) > 1e-12 || std::abs(p.d - (dot > 0 ? q.d : -q.d)) > eps) return false;
+  int wide = 0;
+  for (std::size_t k = 0; k < 3; ++k)
+    wide += std::min(p.box[1][k], q.box[1][k]) - std::max(p.box[0][k], q.box[0][k]) > eps;
+  return wide >= 2;
+}
+
 }  // namespace
 
 PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceMeasureOptions& options) {
@@ -132,6 +166,27 @@ PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceM
   for (const auto& w : c.within) check_polynomial(w, "condition");
   for (const auto& list : c.without)
     for (const auto& w : list) check_polynomial(w, "condition");
+  // Coplanar faces of two sources: boundary_faces classifies them whole (no intersection curve
+  // cuts them), so a shared region would be kept twice or not at all; refused here before the
+  // intersections (geom::face_trim can be slow to refuse the thin regions they leave).
+  std::vector<const vmodel::VCell*> src{&c};
+  for (const auto& w : c.within) src.push_back(&w);
+  for (const auto& list : c.without)
+    for (const auto& w : list) src.push_back(&w);
+  const double eps = 1e-9 * model_diagonal(model);
+  std::vector<std::array<Plane, 6>> planes(src.size());
+  for (std::size_t k = 0; k < src.size(); ++k)
+    for (std::size_t f = 0; f < 6; ++f) planes[k][f] = plane_of(spline::boundary_face(src[k]->volume, spline::all_faces[f]), eps);
+  for (std::size_t k = 0; k < src.size(); ++k)
+    for (std::size_t j = k + 1; j < src.size(); ++j)
+      for (std::size_t f = 0; f < 6; ++f)
+        for (std::size_t g = 0; g < 6; ++g)
+          if (coincide(planes[k][f], planes[j][g], eps))
+            throw Error("piece_measures: cell " + std::to_string(cell) + " (" + c.name + "): face " +
+                            std::string(spline::face_name(spline::all_faces[f])) + " of '" + src[k]->name + "' and face " +
+                            std::string(spline::face_name(spline::all_faces[g])) + " of '" + src[j]->name +
+                            "' are coplanar and overlap; expected faces that cross or miss (coincident faces are not cut)",
+                        ErrorKind::failed);
   return piece_measures(boundary_faces(model, cell, options.faces), cell, options);
 }
 
@@ -159,9 +214,11 @@ PieceMeasures piece_measures(const std::vector<BoundaryFace>& faces, int cell, c
   diag = std::sqrt(diag);
 
   Sums s;
+  detail::PatchRules rules;
+  std::vector<detail::PatchPoint> pts;
   for (const auto& f : faces) {
     r.area += f.area;
-    for (const auto& p : f.patches.patches) integrate(p, f.orientation, c, s);
+    for (const auto& p : f.patches.patches) integrate(p, f.orientation, c, rules, pts, s);
   }
   r.volume = (s.volume[0] + s.volume[1] + s.volume[2]) / 3;
   r.closure = std::hypot(s.normal[0], s.normal[1], s.normal[2]) / r.area;

@@ -13,6 +13,10 @@
 //   cavity's walls whole): vol(A - C) = vol(A) - vol(C);
 // - a left-handed box (det J < 0) still has a positive volume: the faces' orientation follows
 //   the Jacobian's sign;
+// - a ball (the 7 polynomial cells of construct's sphere) cut by a box through it, off its
+//   knot lines: vol(S - B) + vol(S n B) = vol(S), vol(S) by the cells' own Gauss quadrature
+//   (exact for polynomial cells), and vol(S n B) against the exact cap pi h^2 (3r - h) / 3
+//   within the primitive's distance from the true sphere;
 // - two boxes in a row, united: the faces between the three pieces are glued, and the faces
 //   left are the union's outer boundary, of the polyhedron's area.
 #include <catch2/catch.hpp>
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "trivox/error.hpp"
+#include "trivox/construct/primitives.hpp"
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/slice/model_boundary.hpp"
 #include "trivox/slice/piece_measures.hpp"
@@ -289,3 +294,20 @@ TEST_CASE("coplanar faces are refused or measured right", "[piece_measures]") {
   }
 }
 
+
+
+TEST_CASE("measures of a ball cut by a box", "[piece_measures]") {
+  // S: radius 1 about the origin; B = [0.3, 2] x [-2, 2]^2. S n B is the cap of height 0.7.
+  VModel S, B;
+  for (auto& c : construct::build_primitive("S", construct::Sphere{{0, 0, 0}, 1})) S.cells.push_back({c.name, c.volume});
+  for (auto& c : construct::build_primitive("B", construct::Box{{0.3, -2, -2}, {2, 2, 2}})) B.cells.push_back({c.name, c.volume});
+  double vs = 0;
+  for (const auto& c : S.cells) vs += geom::volume(c.volume);
+  const VModel D = vmodel::boolean(S, B, BooleanOp::subtraction), I = vmodel::boolean(S, B, BooleanOp::intersection);
+  const double d = total_volume(D), i = total_volume(I);
+  const double h = 0.7, cap = kPi * h * h * (3 - h) / 3;
+  std::printf("ball minus box: %.17g, ball and box: %.17g (cap %.17g), sum %.17g against the ball's cells %.17g\n", d, i, cap,
+              d + i, vs);
+  CHECK(std::abs(d + i - vs) <= 1e-8 * vs);
+  CHECK(std::abs(i - cap) <= 1e-3 * cap);
+}

@@ -18,7 +18,11 @@
 /// has int_dP n dA = 0 and V_x = V_y = V_z. `closure` = |int n dA| / area and `spread` =
 /// max_i |V_i - V| / (area x diagonal) are reported, and above `check_tolerance` piece_measures
 /// throws (a face missing or counted twice, such as coplanar faces of two inputs, which
-/// boundary_faces classifies whole, or a wrong orientation).
+/// boundary_faces classifies whole, or a wrong orientation). Where the faces meet only within
+/// the intersection curves' accuracy both are small but not zero (about 1e-15 for planar cuts,
+/// 1e-7 where a plane cuts a bicubic sphere cell, whose parameter-space trimming curves leave
+/// the plane by up to about 1e-6); the volume's error is then of the order of spread x area x
+/// diagonal.
 ///
 /// The boundary area is the sum of the faces' areas (geom::area: a square root integrand, so
 /// converged Gauss quadrature, not exact). The bounding box is that of the boundary patches,
@@ -31,6 +35,9 @@
 /// polynomial of the trivariate's parameters, not of x, so no polynomial field with divergence
 /// rho exists to integrate over the boundary; it needs the parameter-space region of the piece
 /// (the untrimming of trimmed V-cells, Massarwi & Elber 2016, Sec. 7), which is not built.
+///
+/// Coplanar faces of the piece's trivariate and its direct conditions (planar control nets on one
+/// plane, overlapping) are refused before any intersection: boundary_faces does not cut them.
 ///
 /// Cost: that of boundary_faces (36 (1 + C)^2 surface intersections for C direct conditions,
 /// then trimming and untrimming), plus per patch of degrees (p, q) (2p + 2)(2q + 2) evaluations
@@ -49,7 +56,7 @@ struct PieceMeasureOptions {
   BoundaryFaceOptions faces;
   /// Largest closure and spread accepted (relative, see the file comment); beyond it the
   /// boundary is not closed and piece_measures throws trivox::Error (failed).
-  double check_tolerance = 1e-6;
+  double check_tolerance = 1e-5;
   /// The bounding box's tolerance, relative to the diagonal of the patches' control boxes.
   double bbox_tolerance = 1e-9;
   /// Subdivisions per patch and coordinate before the bound is taken as it is (bbox_tight false).
@@ -77,6 +84,7 @@ struct PieceMeasures {
 /// The measures of `model.cells[cell]` (a plain cell too: its six faces).
 /// @throws trivox::Error (bad_input) for a cell out of range; (failed) when the cell's or a
 ///         direct condition's trivariate is rational (untrimming needs polynomial surfaces),
+///         when two of their faces are coplanar and overlap,
 ///         when the boundary does not close (closure or spread above check_tolerance) or the
 ///         volume is not positive; and as boundary_faces
 PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceMeasureOptions& options = {});
