@@ -19,6 +19,7 @@
 #include "trivox/io/model_file.hpp"
 #include "trivox/scene/scene.hpp"
 #include "trivox/slice/locator.hpp"
+#include "trivox/slice/piece_measures.hpp"
 #include "trivox/slice/trim.hpp"
 
 namespace trivox::cli {
@@ -41,6 +42,9 @@ struct CellQuality {
   const fillet::CornerQuality* corner = nullptr;
   geom::ValidityReport<3> validity;
   double volume = 0.0;
+  /// A Boolean's piece: "boundary" (slice::piece_measures, exact) or "sampled"
+  /// (slice::trimmed_volume, where the boundary measures are refused); null otherwise.
+  const char* volume_method = nullptr;
 };
 
 /// A Shepard fillet's encoding fit (fillet/shepard.hpp) for component k: its two cells, a then b;
@@ -124,6 +128,7 @@ nlohmann::ordered_json report(const scene::SceneBuild& built, const std::vector<
                   {"min_jacobian", r.min_bound},
                   {"max_jacobian", r.max_bound},
                   {"volume", q[i].volume}});
+    if (q[i].volume_method) jc.back()["volume_method"] = q[i].volume_method;
   }
   nlohmann::ordered_json jp = nlohmann::ordered_json::array();
   for (const auto& p : built.primitives) {
@@ -479,12 +484,27 @@ void add_build(CLI::App& app, Common& common) {
     for (std::size_t i = 0; i < built.model.cells.size(); ++i)
       trimmed = trimmed || (!built.model.cells[i].plain() && !q[i].fillet);
     if (trimmed) {
-      const slice::Locator loc(built.model, {.tolerance = 1e-9 * slice::model_diagonal(built.model)});
+      // Exact from the piece's boundary faces (slice/piece_measures.hpp) where they close,
+      // else sampled. A V-rep fillet's volume is exact from its report (T_hbs less the solid
+      // beyond S_b).
+      auto piece = [&](std::size_t i) { return !built.model.cells[i].plain() && !q[i].fillet; };
+      bool sample = false;
       tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
-        // A V-rep fillet's volume is exact from its report (T_hbs less the solid beyond S_b).
-        if (!built.model.cells[i].plain() && !q[i].fillet)
-          q[i].volume = slice::trimmed_volume(loc, static_cast<int>(i));
+        if (!piece(i)) return;
+        try {
+          q[i].volume = slice::piece_measures(built.model, static_cast<int>(i)).volume;
+          q[i].volume_method = "boundary";
+        } catch (const std::exception&) {
+          q[i].volume_method = "sampled";
+        }
       });
+      for (std::size_t i = 0; i < geometry.size(); ++i) sample = sample || (piece(i) && q[i].volume_method[0] == 's');
+      if (sample) {
+        const slice::Locator loc(built.model, {.tolerance = 1e-9 * slice::model_diagonal(built.model)});
+        tbb::parallel_for(std::size_t{0}, geometry.size(), [&](std::size_t i) {
+          if (piece(i) && q[i].volume_method[0] == 's') q[i].volume = slice::trimmed_volume(loc, static_cast<int>(i));
+        });
+      }
     }
     io::save_model(built.model, opt->output);
     const auto j = report(built, q, *opt);

@@ -1,16 +1,21 @@
 // `trivox info MODEL`: what a model holds: cells with orders, control-point counts, bounding box
-// and volume (Gauss quadrature of the Jacobian determinant, exact for polynomial cells),
-// free surfaces, properties and topology counts.
+// and volume (Gauss quadrature of the Jacobian determinant, exact for polynomial cells; for the
+// trimmed pieces of Booleans the divergence theorem on their untrimmed boundary faces,
+// slice/piece_measures.hpp, or sampling where that is refused), free surfaces, properties and
+// topology counts.
 #include <tbb/parallel_for.h>
 
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
+#include <string>
 
 #include "common.hpp"
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/slice/locator.hpp"
+#include "trivox/slice/piece_measures.hpp"
 #include "trivox/slice/trim.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/vmodel/topology.hpp"
@@ -43,18 +48,36 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
   nlohmann::ordered_json cells = nlohmann::ordered_json::array();
   std::vector<double> volumes(m.cells.size());
   tbb::parallel_for(std::size_t{0}, m.cells.size(), [&](std::size_t i) { volumes[i] = geom::signed_volume(m.cells[i].volume); });
-  // Cells trimmed by Booleans: the volume of the admitted part, by sampling (slice/trim.hpp).
+  // Cells trimmed by Booleans: the volume of the admitted part from its boundary faces
+  // (slice/piece_measures.hpp, exact), or by sampling (slice/trim.hpp) where those are refused.
   std::vector<char> trimmed(m.cells.size(), 0);
   bool any_trimmed = false;
   for (std::size_t i = 0; i < m.cells.size(); ++i) {
     trimmed[i] = !m.cells[i].plain();
     any_trimmed = any_trimmed || trimmed[i];
   }
+  std::vector<std::optional<slice::PieceMeasures>> exact(m.cells.size());
+  std::vector<std::string> refused(m.cells.size());
   if (any_trimmed) {
-    const slice::Locator loc(m, {.tolerance = 1e-9 * slice::model_diagonal(m)});
     tbb::parallel_for(std::size_t{0}, m.cells.size(), [&](std::size_t i) {
-      if (trimmed[i]) volumes[i] = (volumes[i] < 0 ? -1.0 : 1.0) * slice::trimmed_volume(loc, static_cast<int>(i));
+      if (!trimmed[i]) return;
+      try {
+        exact[i] = slice::piece_measures(m, static_cast<int>(i));
+      } catch (const std::exception& e) {
+        refused[i] = e.what();
+      }
     });
+    bool sample = false;
+    for (std::size_t i = 0; i < m.cells.size(); ++i) sample = sample || (trimmed[i] && !exact[i]);
+    if (sample) {
+      const slice::Locator loc(m, {.tolerance = 1e-9 * slice::model_diagonal(m)});
+      tbb::parallel_for(std::size_t{0}, m.cells.size(), [&](std::size_t i) {
+        if (trimmed[i] && !exact[i])
+          volumes[i] = (volumes[i] < 0 ? -1.0 : 1.0) * slice::trimmed_volume(loc, static_cast<int>(i));
+      });
+    }
+    for (std::size_t i = 0; i < m.cells.size(); ++i)
+      if (exact[i]) volumes[i] = (volumes[i] < 0 ? -1.0 : 1.0) * exact[i]->volume;
   }
   double total = 0;
   std::vector<double> lo(3, std::numeric_limits<double>::infinity()), hi(3, -std::numeric_limits<double>::infinity());
@@ -70,7 +93,21 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
     c["orientation"] = volumes[i] < 0 ? "left-handed" : "right-handed";
     if (trimmed[i]) {
       c["trimmed"] = true;
-      c["volume_method"] = "sampled: 16^3 sub-boxes x 8 Gauss points, membership per point";
+      if (const auto& e = exact[i]) {
+        c["volume_method"] = "boundary";
+        nlohmann::ordered_json piece = {{"empty", e->empty}, {"boundary_area", e->area}, {"faces", e->faces},
+                                        {"patches", e->patches}};
+        if (!e->empty) {
+          piece["centroid"] = e->centroid;
+          piece["bbox"] = e->bbox;
+          piece["closure"] = e->closure;
+          piece["spread"] = e->spread;
+        }
+        c["piece"] = std::move(piece);
+      } else {
+        c["volume_method"] = "sampled";
+        c["volume_note"] = "16^3 sub-boxes x 8 Gauss points, membership per point; boundary measures refused: " + refused[i];
+      }
     }
     total += std::abs(volumes[i]);
     grow(c["bbox"]);
@@ -120,6 +157,11 @@ void print_human(const nlohmann::ordered_json& j) {
                   vec(c["counts"]).c_str(), fmt(c["volume"].get<double>(), 10).c_str(), vec(c["bbox"][0]).c_str(),
                   vec(c["bbox"][1]).c_str(), c["rational"].get<bool>() ? "  rational" : "");
     std::printf("total volume: %s\n", fmt(j["volume"].get<double>(), 12).c_str());
+    int boundary = 0, sampled = 0;
+    for (const auto& c : j["cells"])
+      if (c.contains("volume_method")) ++(c["volume_method"] == "boundary" ? boundary : sampled);
+    if (boundary + sampled > 0)
+      std::printf("trimmed cells: %d measured on their boundary faces (exact), %d sampled (approximate)\n", boundary, sampled);
   }
   if (!j["surfaces"].empty()) {
     std::printf("\n%-16s %-10s %-13s %s\n", "surface", "orders", "counts", "bounding box");
