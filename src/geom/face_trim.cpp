@@ -757,10 +757,25 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
   for (std::size_t r = 0; r < nr; ++r) {
     std::vector<TrimLoop> loops{loop_of(regions[r].outer)};
     for (const auto& h : regions[r].holes) loops.push_back(loop_of(h));
+    // untrim merges events closer than the surface's tolerance, which costs area of that order:
+    // the loops get the tightest tolerance they meet, twice their largest gap between
+    // consecutive pieces and control point outside the rectangle (at least 1e-10, at most
+    // options.tolerance; relative to L).
+    double gap = 0;
+    for (const auto& l : loops)
+      for (std::size_t k = 0; k < l.pieces.size(); ++k) {
+        const auto& c = l.pieces[k];
+        const auto& n = l.pieces[(k + 1) % l.pieces.size()];
+        gap = std::max(gap, dist(eval2(c, c.domain(0)[1]), eval2(n, n.domain(0)[0])));
+        const auto cp = c.points();
+        for (std::size_t m = 0; m + 1 < cp.size(); m += 2)
+          gap = std::max({gap, u0 - cp[m], cp[m] - u1, v0 - cp[m + 1], cp[m + 1] - v1});
+      }
+    const double loop_tol = std::min(options.tolerance, std::max(1e-10, 2 * gap / L));
     const Pt q = best_p[r];
     face.eval({q[0], q[1]}, xyz.data());
     const bool k = keep(xyz.data());
-    out.push_back(FaceRegion{TrimmedSurface(face, std::move(loops), options.tolerance), q[0], q[1], k});
+    out.push_back(FaceRegion{TrimmedSurface(face, std::move(loops), loop_tol), q[0], q[1], k});
   }
   return out;
 }
