@@ -24,32 +24,30 @@ ModelBoundary model_boundary(const vmodel::VModel& model, const ModelBoundaryOpt
     }
     for (auto& b : f) out.faces.push_back(std::move(b));
   }
+  std::vector<double> buf;
   for (auto& f : out.faces) {
-    int found = 0, patches = 0;
+    int found = 0, tested = 0;
     for (const auto& p : f.patches.patches) {
-      ++patches;
-      // The middle of the patch; its normal, or a nearby point's where the patch degenerates.
-      std::vector<double> buf(static_cast<std::size_t>(3 * p.dim()));
-      double n[3] = {0, 0, 0}, len = 0;
-      Vec3 x{};
-      for (const double t : {0.5, 0.4, 0.6, 0.3}) {
-        p.eval_derivatives({t, t}, 1, buf.data());
-        const double* xs = buf.data() + p.dim();
-        const double* xt = xs + p.dim();
-        n[0] = xs[1] * xt[2] - xs[2] * xt[1], n[1] = xs[2] * xt[0] - xs[0] * xt[2], n[2] = xs[0] * xt[1] - xs[1] * xt[0];
-        len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        x = {buf[0], buf[1], buf[2]};
-        if (len > 0) break;
-      }
-      if (!(len > 0)) continue;  // a degenerate patch (zero area) decides nothing
-      const double s = f.orientation * delta / len;
-      const LocateResult r = loc.locate({x[0] + s * n[0], x[1] + s * n[1], x[2] + s * n[2]});
-      if (r.inside && r.cell != f.cell) {
-        ++found;
-        if (f.glued_to < 0) f.glued_to = r.cell;
-      }
+      buf.resize(static_cast<std::size_t>(3 * p.dim()));
+      // 3 x 3 points of the patch, at the middles of its thirds.
+      for (const double s : {1.0 / 6, 0.5, 5.0 / 6})
+        for (const double t : {1.0 / 6, 0.5, 5.0 / 6}) {
+          p.eval_derivatives({s, t}, 1, buf.data());
+          const double* xs = buf.data() + p.dim();
+          const double* xt = xs + p.dim();
+          const double n[3] = {xs[1] * xt[2] - xs[2] * xt[1], xs[2] * xt[0] - xs[0] * xt[2], xs[0] * xt[1] - xs[1] * xt[0]};
+          const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+          if (!(len > 0)) continue;  // a degenerate point (a collapsed side) decides nothing
+          ++tested;
+          const double h = f.orientation * delta / len;
+          const LocateResult r = loc.locate({buf[0] + h * n[0], buf[1] + h * n[1], buf[2] + h * n[2]});
+          if (r.inside && r.cell != f.cell) {
+            ++found;
+            if (f.glued_to < 0) f.glued_to = r.cell;
+          }
+        }
     }
-    f.glued = found > 0 && found == patches;
+    f.glued = found > 0 && found == tested;
     if (f.glued_to < 0) out.outer_area += f.area;
     if (f.glued) out.glued_area += f.area;
     if (f.glued_to >= 0 && !f.glued) ++out.partly_glued;

@@ -311,3 +311,30 @@ TEST_CASE("measures of a ball cut by a box", "[piece_measures]") {
   CHECK(std::abs(d + i - vs) <= 1e-8 * vs);
   CHECK(std::abs(i - cap) <= 1e-3 * cap);
 }
+
+TEST_CASE("glued faces of plain cells", "[model_boundary]") {
+  // Two plain cells face to face, [0, 1]^3 and [1, 2] x [0, 1]^2: their x = 1 faces are glued
+  // to each other (area 1 each), the outer boundary is that of [0, 2] x [0, 1]^2, 10. A small
+  // box [0.25, 0.75]^2 x [1, 1.5] standing on the first: its bottom is glued whole, the first
+  // cell's top only partly (its patch's middle is under the small box: glued_to set, not glued).
+  VModel m = box("L", {0, 0, 0}, {1, 1, 1});
+  m.cells.push_back(box("R", {1, 0, 0}, {2, 1, 1}).cells[0]);
+  auto mb = slice::model_boundary(m);
+  REQUIRE(mb.faces.size() == 12);
+  CHECK(mb.faces[1].glued);  // L's u1
+  CHECK(mb.faces[1].glued_to == 1);
+  CHECK(mb.faces[6].glued);  // R's u0
+  CHECK(mb.faces[6].glued_to == 0);
+  CHECK(std::abs(mb.outer_area - 10) <= 1e-12 * 10);
+  CHECK(std::abs(mb.glued_area - 2) <= 1e-12 * 2);
+  CHECK(mb.partly_glued == 0);
+  m.cells.push_back(box("S", {0.25, 0.25, 1}, {0.75, 0.75, 1.5}).cells[0]);
+  mb = slice::model_boundary(m);
+  REQUIRE(mb.faces.size() == 18);
+  CHECK(mb.faces[16].glued);  // S's w0
+  CHECK(mb.faces[16].glued_to == 0);
+  CHECK(!mb.faces[5].glued);  // L's w1: the small box covers a quarter of it
+  CHECK(mb.faces[5].glued_to == 2);
+  CHECK(mb.partly_glued == 1);
+  CHECK_THROWS_AS(slice::model_boundary(VModel{}), Error);
+}

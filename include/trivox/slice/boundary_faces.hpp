@@ -54,7 +54,7 @@ struct BoundaryFace {
   /// geom::untrim(surface): Bezier patches tiling the region, with S's orientation.
   geom::Untrimmed patches;
   /// Set by slice::model_boundary only (false and -1 here): `glued` when the point just outside
-  /// the face (along the outward normal, at the middle of every patch) lies in another cell of
+  /// the face (along the outward normal, at 3 x 3 points of every patch) lies in another cell of
   /// the model, so the face is interior to the model; `glued_to` the cell found there at the
   /// first patch that found one (-1: none). A face with glued_to >= 0 and !glued is partly glued.
   bool glued = false;

@@ -3,16 +3,16 @@
 /// (the interior faces of a union, the shared faces of a multi-cell primitive) flagged, so that
 /// the model's outer boundary is the faces left unglued.
 ///
-/// A face of cell P is glued when the point just outside it lies in another cell: at the middle
-/// X(1/2, 1/2) of each of its untrimmed patches, offset along the piece's outward normal by
-/// `offset` x the model's diagonal, slice::Locator::locate (which honours the Booleans'
-/// trimming) finds a cell there. Two pieces sharing a surface region see it from both sides
+/// A face of cell P is glued when the point just outside it lies in another cell: at 3 x 3
+/// points of each of its untrimmed patches (the middles of the patch's thirds), offset along the
+/// piece's outward normal by `offset` x the model's diagonal, slice::Locator::locate (which
+/// honours the Booleans' trimming) finds a cell there. Two pieces sharing a surface region see it from both sides
 /// with opposite outward normals, so each of the two faces finds the other's cell. A face whose
 /// patches disagree (some find a cell, some none) is partly glued: BoundaryFace::glued_to is set
 /// and BoundaryFace::glued is not, and it counts in `partly_glued`; such a face is not split
 /// where the other cell ends (boundary_faces cuts a piece's faces only by its own conditions).
 ///
-/// Cost: boundary_faces for every cell, one Locator over the model, one point location per
+/// Cost: boundary_faces for every cell, one Locator over the model, nine point locations per
 /// patch.
 #pragma once
 #include <vector>
