@@ -173,6 +173,11 @@ PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceM
   for (const auto& w : c.within) src.push_back(&w);
   for (const auto& list : c.without)
     for (const auto& w : list) src.push_back(&w);
+  if (static_cast<int>(src.size()) - 1 > options.max_conditions)
+    throw Error("piece_measures: cell " + std::to_string(cell) + " (" + c.name + ") has " + std::to_string(src.size() - 1) +
+                    " direct conditions; expected at most " + std::to_string(options.max_conditions) +
+                    " (its boundary faces intersect 36 (1 + C)^2 pairs of faces)",
+                ErrorKind::failed);
   const double eps = 1e-9 * model_diagonal(model);
   std::vector<std::array<Plane, 6>> planes(src.size());
   for (std::size_t k = 0; k < src.size(); ++k)

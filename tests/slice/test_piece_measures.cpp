@@ -338,3 +338,13 @@ TEST_CASE("glued faces of plain cells", "[model_boundary]") {
   CHECK(mb.partly_glued == 1);
   CHECK_THROWS_AS(slice::model_boundary(VModel{}), Error);
 }
+
+TEST_CASE("measures refuse more conditions than allowed", "[piece_measures]") {
+  const VModel A = box("A", {0, 0, 0}, {2, 2, 1}), B = box("B", {0.25, 0.5, -1}, {0.75, 1.5, 2});
+  const VModel D = vmodel::boolean(A, B, BooleanOp::subtraction);
+  slice::PieceMeasureOptions o;
+  o.max_conditions = 0;
+  CHECK_THROWS_AS(slice::piece_measures(D, 0, o), Error);
+  o.max_conditions = 1;
+  CHECK(std::abs(slice::piece_measures(D, 0, o).volume - 3.5) <= 1e-12 * 3.5);
+}

@@ -61,6 +61,9 @@ struct PieceMeasureOptions {
   double bbox_tolerance = 1e-9;
   /// Subdivisions per patch and coordinate before the bound is taken as it is (bbox_tight false).
   int bbox_budget = 4096;
+  /// Most direct conditions accepted: boundary_faces intersects 36 (1 + C)^2 pairs of faces,
+  /// 2,916 at 8. Beyond it piece_measures throws trivox::Error (failed) before intersecting.
+  int max_conditions = 8;
 };
 
 struct PieceMeasures {
@@ -84,7 +87,8 @@ struct PieceMeasures {
 /// The measures of `model.cells[cell]` (a plain cell too: its six faces).
 /// @throws trivox::Error (bad_input) for a cell out of range; (failed) when the cell's or a
 ///         direct condition's trivariate is rational (untrimming needs polynomial surfaces),
-///         when two of their faces are coplanar and overlap,
+///         when two of their faces are coplanar and overlap, for more than max_conditions
+///         direct conditions,
 ///         when the boundary does not close (closure or spread above check_tolerance) or the
 ///         volume is not positive; and as boundary_faces
 PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceMeasureOptions& options = {});
