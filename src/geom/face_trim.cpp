@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <sstream>
 #include <utility>
@@ -20,6 +21,8 @@ using Pt = std::array<double, 2>;
 using Poly = std::vector<Pt>;
 
 constexpr std::size_t kMaxSegments = 200'000;
+constexpr std::int64_t kMaxPairTests = 50'000'000;
+constexpr std::size_t kMaxEvents = 100'000;
 
 std::string fmt(double x) {
   std::ostringstream s;
@@ -288,14 +291,39 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
     for (int s = 0; s < 4; ++s)
       if (along[s] <= tol) active[i] = false;  // along a side
   }
-  // Distance from q to curve j: nearest polyline point, then refined on the curve.
+  // Polyline segments in buckets of a uniform grid, by their boxes grown by twice the tolerance.
+  struct Seg {
+    int curve, k;
+    std::array<int, 4> cells;
+  };
+  std::vector<Seg> segs;
+  const int nb = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(total_segments) / 4)), 1, 256);
+  const double grow = 2 * tol;
+  Buckets bk(u0 - grow, v0 - grow, W + 2 * grow, H + 2 * grow, nb);
+  for (std::size_t i = 0; i < nc; ++i) {
+    if (!active[i]) continue;
+    const Poly& p = smp[i].p;
+    for (std::size_t k = 0; k + 1 < p.size(); ++k) {
+      const double lx = std::min(p[k][0], p[k + 1][0]) - grow, ly = std::min(p[k][1], p[k + 1][1]) - grow;
+      const double hx = std::max(p[k][0], p[k + 1][0]) + grow, hy = std::max(p[k][1], p[k + 1][1]) + grow;
+      bk.add(static_cast<int>(segs.size()), lx, ly, hx, hy);
+      segs.push_back({static_cast<int>(i), static_cast<int>(k), bk.range(lx, ly, hx, hy)});
+    }
+  }
+  // Distance from q to curve j (infinite beyond twice the tolerance): the nearest of its
+  // polyline segments in q's bucket, then refined on the curve.
   auto to_curve = [&](std::size_t j, Pt q, double* param) {
     const Sampled& s = smp[j];
     double best = std::numeric_limits<double>::infinity(), bt = s.t[0];
-    for (std::size_t k = 0; k + 1 < s.p.size(); ++k) {
+    const auto r = bk.range(q[0], q[1], q[0], q[1]);
+    for (int x : bk.cells[static_cast<std::size_t>(r[1]) * static_cast<std::size_t>(nb) + static_cast<std::size_t>(r[0])]) {
+      const Seg& g = segs[static_cast<std::size_t>(x)];
+      if (g.curve != static_cast<int>(j)) continue;
+      const std::size_t k = static_cast<std::size_t>(g.k);
       const auto [d, f] = seg_closest(q, s.p[k], s.p[k + 1]);
       if (d < best) best = d, bt = s.t[k] + f * (s.t[k + 1] - s.t[k]);
     }
+    if (!(best <= grow)) return std::numeric_limits<double>::infinity();
     const double t = project(cuts[j], q, bt);
     if (param) *param = t;
     return std::min(best, dist(eval2(cuts[j], t), q));
@@ -342,22 +370,6 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
     add_event(i, dom[0], smp[i].p.front());
     add_event(i, dom[1], smp[i].p.back());
   }
-  // Segments in buckets.
-  struct Seg {
-    int curve, k;
-  };
-  std::vector<Seg> segs;
-  const int nb = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(total_segments) / 4)), 1, 256);
-  Buckets bk(u0 - tol, v0 - tol, W + 2 * tol, H + 2 * tol, nb);
-  for (std::size_t i = 0; i < nc; ++i) {
-    if (!active[i]) continue;
-    const Poly& p = smp[i].p;
-    for (std::size_t k = 0; k + 1 < p.size(); ++k) {
-      bk.add(static_cast<int>(segs.size()), std::min(p[k][0], p[k + 1][0]) - tol, std::min(p[k][1], p[k + 1][1]) - tol,
-             std::max(p[k][0], p[k + 1][0]) + tol, std::max(p[k][1], p[k + 1][1]) + tol);
-      segs.push_back({static_cast<int>(i), static_cast<int>(k)});
-    }
-  }
   // Junctions: an open curve's end on another curve (or on itself, away from that end).
   std::vector<std::pair<int, int>> junction_of_end;  // (curve, other curve) for ends that met one
   std::vector<Pt> junction_point;
@@ -369,7 +381,8 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
       std::vector<int> near;
       for (int y = r[1]; y <= r[3]; ++y)
         for (int x = r[0]; x <= r[2]; ++x)
-          for (int s : bk.cells[static_cast<std::size_t>(y) * nb + x]) near.push_back(segs[static_cast<std::size_t>(s)].curve);
+          for (int s : bk.cells[static_cast<std::size_t>(y) * nb + x])
+            if (active[static_cast<std::size_t>(segs[static_cast<std::size_t>(s)].curve)]) near.push_back(segs[static_cast<std::size_t>(s)].curve);
       std::sort(near.begin(), near.end());
       near.erase(std::unique(near.begin(), near.end()), near.end());
       for (int j : near) {
@@ -384,71 +397,87 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
   }
   // Crossings: segment pairs within the tolerance, refined by Newton on the curves.
   {
+    // Crossings found per curve pair, to merge repeats.
+    std::map<std::pair<std::size_t, std::size_t>, std::vector<Pt>> found;
+    std::int64_t tests = 0;
     std::vector<std::pair<int, int>> pairs;
-    for (const auto& cell : bk.cells)
-      for (std::size_t x = 0; x < cell.size(); ++x)
-        for (std::size_t y = x + 1; y < cell.size(); ++y) pairs.push_back({std::min(cell[x], cell[y]), std::max(cell[x], cell[y])});
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    // Crossings found, per curve pair, to merge repeats.
-    std::vector<std::array<double, 6>> found;  // curve a, curve b, s, t, u, v
-    for (const auto& [x, y] : pairs) {
-      const Seg& A = segs[static_cast<std::size_t>(x)];
-      const Seg& B = segs[static_cast<std::size_t>(y)];
-      const std::size_t i = static_cast<std::size_t>(A.curve), j = static_cast<std::size_t>(B.curve);
-      const Poly& pi = smp[i].p;
-      const Poly& pj = smp[j].p;
-      if (i == j) {
-        const int n = static_cast<int>(pi.size()) - 1;
-        const int k = std::abs(A.k - B.k);
-        if (k <= 1 || (closed[i] && k == n - 1)) continue;
-      }
-      const SegPair sp = seg_seg(pi[static_cast<std::size_t>(A.k)], pi[static_cast<std::size_t>(A.k) + 1],
-                                 pj[static_cast<std::size_t>(B.k)], pj[static_cast<std::size_t>(B.k) + 1]);
-      if (sp.d > tol) continue;
-      const auto& ti = smp[i].t;
-      const auto& tj = smp[j].t;
-      double s = ti[static_cast<std::size_t>(A.k)] + sp.s * (ti[static_cast<std::size_t>(A.k) + 1] - ti[static_cast<std::size_t>(A.k)]);
-      double t = tj[static_cast<std::size_t>(B.k)] + sp.t * (tj[static_cast<std::size_t>(B.k) + 1] - tj[static_cast<std::size_t>(B.k)]);
-      const Pt guess = eval2(cuts[i], s);
-      // An end of one curve near the pair that meets the other curve there (a junction, ends
-      // meeting end to end, or both ends on the boundary): that meeting is already a vertex, and
-      // only a crossing Newton finds away from it is another.
-      const double window = 4 * tol + dist(pi[static_cast<std::size_t>(A.k)], pi[static_cast<std::size_t>(A.k) + 1]) +
-                            dist(pj[static_cast<std::size_t>(B.k)], pj[static_cast<std::size_t>(B.k) + 1]);
-      std::vector<Pt> meetings;
-      for (std::size_t q = 0; q < junction_of_end.size(); ++q) {
-        const auto [a, b] = junction_of_end[q];
-        if ((a == static_cast<int>(i) && b == static_cast<int>(j)) || (a == static_cast<int>(j) && b == static_cast<int>(i)))
-          if (dist(junction_point[q], guess) <= window) meetings.push_back(junction_point[q]);
-      }
-      if (!(i == j && closed[i])) {
-        const Pt ends[4] = {pi.front(), pi.back(), pj.front(), pj.back()};
-        for (int x = 0; x < 4; ++x) {
-          if (dist(ends[x], guess) > window) continue;
-          bool met = off_boundary(ends[x]) <= tol;
-          for (int y = (x < 2 ? 2 : 0); y < (x < 2 ? 4 : 2); ++y) met = met || dist(ends[x], ends[y]) <= tol;
-          if (met) meetings.push_back(ends[x]);
+    for (int cy = 0; cy < nb; ++cy)
+      for (int cx = 0; cx < nb; ++cx) {
+        // Each pair once: in the first bucket the two segments share.
+        const auto& cell = bk.cells[static_cast<std::size_t>(cy) * static_cast<std::size_t>(nb) + static_cast<std::size_t>(cx)];
+        pairs.clear();
+        for (std::size_t a = 0; a < cell.size(); ++a)
+          for (std::size_t b = a + 1; b < cell.size(); ++b) {
+            const Seg& A = segs[static_cast<std::size_t>(cell[a])];
+            const Seg& B = segs[static_cast<std::size_t>(cell[b])];
+            if (!active[static_cast<std::size_t>(A.curve)] || !active[static_cast<std::size_t>(B.curve)]) continue;
+            if (std::max(A.cells[0], B.cells[0]) != cx || std::max(A.cells[1], B.cells[1]) != cy) continue;
+            if (++tests > kMaxPairTests)
+              throw Error(name + ": cutting curves too dense (more than " + std::to_string(kMaxPairTests) +
+                          " pairs of polyline segments near one another)");
+            pairs.push_back({std::min(cell[a], cell[b]), std::max(cell[a], cell[b])});
+          }
+        std::sort(pairs.begin(), pairs.end());
+        for (const auto& [x, y] : pairs) {
+          const Seg& A = segs[static_cast<std::size_t>(x)];
+          const Seg& B = segs[static_cast<std::size_t>(y)];
+          const std::size_t i = static_cast<std::size_t>(A.curve), j = static_cast<std::size_t>(B.curve);
+          const Poly& pi = smp[i].p;
+          const Poly& pj = smp[j].p;
+          if (i == j) {
+            const int n = static_cast<int>(pi.size()) - 1;
+            const int k = std::abs(A.k - B.k);
+            if (k <= 1 || (closed[i] && k == n - 1)) continue;
+          }
+          const SegPair sp = seg_seg(pi[static_cast<std::size_t>(A.k)], pi[static_cast<std::size_t>(A.k) + 1],
+                                     pj[static_cast<std::size_t>(B.k)], pj[static_cast<std::size_t>(B.k) + 1]);
+          if (sp.d > tol) continue;
+          const auto& ti = smp[i].t;
+          const auto& tj = smp[j].t;
+          double s = ti[static_cast<std::size_t>(A.k)] + sp.s * (ti[static_cast<std::size_t>(A.k) + 1] - ti[static_cast<std::size_t>(A.k)]);
+          double t = tj[static_cast<std::size_t>(B.k)] + sp.t * (tj[static_cast<std::size_t>(B.k) + 1] - tj[static_cast<std::size_t>(B.k)]);
+          const Pt guess = eval2(cuts[i], s);
+          // An end of one curve near the pair that meets the other curve there (a junction, ends
+          // meeting end to end, or both ends on the boundary): that meeting is already a vertex, and
+          // only a crossing Newton finds away from it is another.
+          const double window = 4 * tol + dist(pi[static_cast<std::size_t>(A.k)], pi[static_cast<std::size_t>(A.k) + 1]) +
+                                dist(pj[static_cast<std::size_t>(B.k)], pj[static_cast<std::size_t>(B.k) + 1]);
+          std::vector<Pt> meetings;
+          for (std::size_t q = 0; q < junction_of_end.size(); ++q) {
+            const auto [a, b] = junction_of_end[q];
+            if ((a == static_cast<int>(i) && b == static_cast<int>(j)) || (a == static_cast<int>(j) && b == static_cast<int>(i)))
+              if (dist(junction_point[q], guess) <= window) meetings.push_back(junction_point[q]);
+          }
+          if (!(i == j && closed[i])) {
+            const Pt ends[4] = {pi.front(), pi.back(), pj.front(), pj.back()};
+            for (int x = 0; x < 4; ++x) {
+              if (dist(ends[x], guess) > window) continue;
+              bool met = off_boundary(ends[x]) <= tol;
+              for (int y = (x < 2 ? 2 : 0); y < (x < 2 ? 4 : 2); ++y) met = met || dist(ends[x], ends[y]) <= tol;
+              if (met) meetings.push_back(ends[x]);
+            }
+          }
+          const bool ok = meet(cuts[i], cuts[j], s, t, 1e-3 * tol);
+          const Pt p = eval2(cuts[i], s);
+          if (!meetings.empty()) {
+            bool away = ok;
+            for (const Pt& m : meetings) away = away && dist(m, p) > 2 * tol;
+            if (!away) continue;
+          }
+          if (!ok || (i == j && std::abs(s - t) <= 1e-12 * (cuts[i].domain(0)[1] - cuts[i].domain(0)[0])))
+            throw Error(name + ": cutting curves " + std::to_string(i) + " and " + std::to_string(j) + " touch or overlap near " + at(guess) +
+                        " without crossing; expected curves that cross, or meet at their ends, within " + fmt(tol));
+          auto& f = found[{i, j}];
+          bool seen = false;
+          for (const Pt& q : f) seen = seen || dist(q, p) <= tol;
+          if (seen) continue;
+          f.push_back(p);
+          if (events.size() > kMaxEvents)
+            throw Error(name + ": cutting curves cross or meet at more than " + std::to_string(kMaxEvents) + " points");
+          add_event(i, s, p);
+          add_event(j, t, eval2(cuts[j], t));
         }
       }
-      const bool ok = meet(cuts[i], cuts[j], s, t, 1e-3 * tol);
-      const Pt p = eval2(cuts[i], s);
-      if (!meetings.empty()) {
-        bool away = ok;
-        for (const Pt& m : meetings) away = away && dist(m, p) > 2 * tol;
-        if (!away) continue;
-      }
-      if (!ok || (i == j && std::abs(s - t) <= 1e-12 * (cuts[i].domain(0)[1] - cuts[i].domain(0)[0])))
-        throw Error(name + ": cutting curves " + std::to_string(i) + " and " + std::to_string(j) + " touch or overlap near " + at(guess) +
-                    " without crossing; expected curves that cross, or meet at their ends, within " + fmt(tol));
-      bool seen = false;
-      for (const auto& f : found)
-        if (f[0] == static_cast<double>(i) && f[1] == static_cast<double>(j) && dist({f[4], f[5]}, p) <= tol) seen = true;
-      if (seen) continue;
-      found.push_back({static_cast<double>(i), static_cast<double>(j), s, t, p[0], p[1]});
-      add_event(i, s, p);
-      add_event(j, t, eval2(cuts[j], t));
-    }
   }
   // Clusters of events within the tolerance (single linkage), numbered in event order.
   const std::size_t nev = events.size();

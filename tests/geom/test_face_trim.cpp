@@ -346,6 +346,16 @@ TEST_CASE("trim_face: a circle of four arcs crossed by a line", "[face_trim]") {
     half = ac / 2;
     check_regions(regions, [](double u, double v) { return std::hypot(u - 0.5, v - 0.5) < 0.3 ? half : 0.5 - half; },
                   a0 > 0 ? "circle crossed inside arcs" : "circle crossed at arc ends");
+    // Determinism: the same regions, points and loops again.
+    const auto again = geom::face_regions(planar_face(), cuts, all);
+    REQUIRE(again.size() == regions.size());
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      CHECK(again[i].u == regions[i].u);
+      CHECK(again[i].v == regions[i].v);
+      REQUIRE(again[i].surface.loops().size() == regions[i].surface.loops().size());
+      for (std::size_t k = 0; k < regions[i].surface.loops().size(); ++k)
+        CHECK(again[i].surface.loops()[k].pieces == regions[i].surface.loops()[k].pieces);
+    }
   }
 }
 
