@@ -29,9 +29,9 @@
 /// Adjacent kept regions are NOT merged: each is returned separately (their areas add up).
 ///
 /// Cost: polylines of at most 16 points per knot span of each curve (capped at 4096 per curve,
-/// refused beyond 200,000 segments in all); crossings tested on segment pairs sharing a bucket of
-/// a uniform grid (about S^1.5 pairs at worst for S segments), each refined by a few Newton
-/// steps; the interior points test G^2 grid points (G = 32, doubled up to 256 while a region
+/// refused beyond 200,000 segments in all), held in a uniform grid of buckets; crossings tested
+/// once per pair of segments sharing a bucket (refused beyond 5e7 pairs or 1e5 meeting points),
+/// each refined by a few Newton steps; the interior points test G^2 grid points (G = 32, doubled up to 256 while a region
 /// has no grid point) against the regions' polygons and the S segments. Refused beyond
 /// FaceTrimOptions::max_curves.
 #pragma once
