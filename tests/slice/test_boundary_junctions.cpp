@@ -8,8 +8,8 @@
 //   (Green's theorem, 1/2 loop integral of x y' - y x', exact Gauss rule for the polynomial
 //   integrand; the length with 64 Gauss points per span of a smooth integrand); the faces shared
 //   by two of the cylinder's cells lie inside C and bound nothing.
-// The 7-cell sphere does not yet serve: its cells' faces meet at single points (the caps'
-// corners), where geom::intersect_surfaces fails to fit a curve through one point.
+// The 7-cell sphere and the 5-cell torus do not yet serve: some of their cells' faces meet at
+// single points, where geom::intersect_surfaces fails to fit a curve through one point.
 // The holes are bounded by marched intersection curves, within their tolerance (1e-10) of the
 // exact sections, so areas agree to about 1e-9, checked to 1e-8 relative.
 #include <catch2/catch.hpp>
