@@ -7,7 +7,9 @@
 //   perimeter of the cylinder's cross-section, computed from its four outer cells' lateral faces
 //   (Green's theorem, 1/2 loop integral of x y' - y x', exact Gauss rule for the polynomial
 //   integrand; the length with 64 Gauss points per span of a smooth integrand); the faces shared
-//   by two of the cylinder's cells lie inside C and bound nothing.
+//   by two of the cylinder's cells lie inside C and bound nothing;
+// - minus the same cylinder wholly inside it (z in [0.25, 0.75], a cavity): 16 + 2 A_c + 0.5 L_c,
+//   the lid and floor made of the five cells' end faces, and no shared face reported.
 // The 7-cell sphere and the 5-cell torus do not yet serve: some of their cells' faces meet at
 // single points, where geom::intersect_surfaces fails to fit a curve through one point.
 // The holes are bounded by marched intersection curves, within their tolerance (1e-10) of the
@@ -128,3 +130,39 @@ TEST_CASE("boundary faces of a box minus the 5-cell cylinder through it", "[boun
   CHECK(std::abs(wall - sec.length) <= 1e-8 * sec.length);
   CHECK(std::abs(d - expected) <= 1e-8 * expected);
 }
+
+TEST_CASE("boundary faces of a box minus the 5-cell cylinder inside it", "[boundary_faces][junctions]") {
+  // The cylinder z in [0.25, 0.75] is a cavity: the box keeps its 16, the cavity's lid and floor
+  // are the five cells' w faces (2 A_c), its wall the outer cells' u1 faces (0.5 L_c); every
+  // other face of the cells is shared by two of them and lies inside C.
+  const VModel A = unit_box();
+  const VModel C = primitive(construct::Cylinder{{0, 0, 0.25}, {0, 0, 1}, 0.5, 0.5});
+  Section sec;
+  for (const auto& c : C.cells) {
+    if (c.name == "p.core") continue;
+    const auto f = spline::boundary_face(c.volume, spline::Face::u1);
+    const auto wd = f.domain(1);
+    add_section(f, 0, 0.5 * (wd[0] + wd[1]), 0.5, sec);
+  }
+  REQUIRE(sec.z_off < 1e-12);
+  const VModel D = vmodel::boolean(A, C, BooleanOp::subtraction);
+  std::vector<slice::BoundaryFace> faces;
+  const double d = model_boundary(D, &faces);
+  double own = 0, lids = 0, wall = 0;
+  for (const auto& f : faces) {
+    if (f.source == -1) own += f.area;
+    else if (f.face == spline::Face::w0 || f.face == spline::Face::w1) lids += f.area;
+    else if (f.face == spline::Face::u1 && f.source_name != "p.core") wall += f.area;
+    else FAIL("a face shared by two cells is reported: " << f.source_name << " " << spline::face_name(f.face));
+  }
+  const double expected = 16 + 2 * sec.area + 0.5 * sec.length;
+  std::printf("box minus 5-cell cylinder inside: %zu faces, own %.15g, lid and floor %.15g (2 A_c = %.15g), wall %.15g "
+              "(0.5 L_c = %.15g), boundary %.15g (expected %.15g)\n",
+              faces.size(), own, lids, 2 * sec.area, wall, 0.5 * sec.length, d, expected);
+  CHECK(faces.size() == 6 + 10 + 4);
+  CHECK(std::abs(own - 16) <= 1e-12 * 16);
+  CHECK(std::abs(lids - 2 * sec.area) <= 1e-10 * lids);
+  CHECK(std::abs(wall - 0.5 * sec.length) <= 1e-10 * wall);
+  CHECK(std::abs(d - expected) <= 1e-10 * expected);
+}
+
