@@ -236,6 +236,9 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
   const double u0 = du[0], u1 = du[1], v0 = dv[0], v1 = dv[1];
   const double W = u1 - u0, H = v1 - v0, L = std::max(W, H);
   const double tol = options.tolerance * L;
+  if (!(W > 10 * tol && H > 10 * tol && std::isfinite(L)))
+    throw Error(name + ": the parameter rectangle [" + fmt(u0) + ", " + fmt(u1) + "] x [" + fmt(v0) + ", " + fmt(v1) +
+                "] is too thin for the tolerance; expected sides longer than 10 x " + fmt(tol));
   const Pt corners[4] = {{u0, v0}, {u1, v0}, {u1, v1}, {u0, v1}};
   const double perimeter = 2 * (W + H);
   auto off_boundary = [&](Pt q) {
@@ -270,6 +273,8 @@ std::vector<FaceRegion> face_regions(const spline::Surface& face, const std::vec
     total_segments += smp[i].p.size() - 1;
     if (total_segments > kMaxSegments)
       throw Error(name + ": cutting curves too long (more than " + std::to_string(kMaxSegments) + " polyline segments)");
+    for (const Pt& q : smp[i].p)
+      if (!std::isfinite(q[0]) || !std::isfinite(q[1])) throw Error(who + " has a point that is not finite");
     for (const Pt& q : smp[i].p)
       if (q[0] < u0 - tol || q[0] > u1 + tol || q[1] < v0 - tol || q[1] > v1 + tol)
         throw Error(who + " leaves the parameter rectangle at " + at(q));

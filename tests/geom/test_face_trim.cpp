@@ -17,6 +17,8 @@
 //   cubic arcs crossed by a line through its centre, symmetric about it, leaves two half-discs
 //   of A_c / 2 (A_c by Green's theorem on the arcs) and 0.5 - A_c / 2 outside; in every case the
 //   regions' areas add up to the face's to 1e-12;
+// - eleven random chords in general position cut the square into 1 + n + k regions (Euler's
+//   formula, k the crossings counted from the segments' equations), tiling it;
 // - a repeated curve and curves along the boundary change nothing;
 // - refusals: an open curve ending inside the rectangle (the message names the face), a curve
 //   crossing another and then ending in the open, an end 1e-3 short of the curve it should
@@ -25,6 +27,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -370,4 +373,36 @@ TEST_CASE("trim_face: repeated curves and curves along the boundary add nothing"
   const auto regions = geom::face_regions(planar_face(), cuts, all);
   REQUIRE(regions.size() == 2);
   check_regions(regions, [](double u, double v) { return (u > 0.3 && u < 0.7 && v > 0.3 && v < 0.7) ? 0.16 : 0.84; }, "repeated");
+}
+
+TEST_CASE("trim_face: random chords give 1 + n + k regions tiling the face", "[face_trim]") {
+  // n straight chords between random points of the left and right sides (and of the bottom and
+  // top sides), in general position: by Euler's formula the square is cut into 1 + n + k regions,
+  // k the number of pairs crossing inside (counted from the lines' equations), and the areas add
+  // up to the face's.
+  std::uint64_t state = 12345;
+  auto next = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return 0.05 + 0.9 * static_cast<double>(state >> 11) / 9007199254740992.0;
+  };
+  std::vector<std::array<Pt, 2>> seg;
+  for (int i = 0; i < 6; ++i) seg.push_back({Pt{0.0, next()}, Pt{1.0, next()}});
+  for (int i = 0; i < 5; ++i) seg.push_back({Pt{next(), 0.0}, Pt{next(), 1.0}});
+  std::vector<Curve> cuts;
+  for (const auto& s : seg) cuts.push_back(polyline({s[0], s[1]}));
+  int k = 0;
+  for (std::size_t a = 0; a < seg.size(); ++a)
+    for (std::size_t b = a + 1; b < seg.size(); ++b) {
+      auto side = [](Pt p, Pt q, Pt r) { return (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]); };
+      const auto& A = seg[a];
+      const auto& B = seg[b];
+      if (side(A[0], A[1], B[0]) * side(A[0], A[1], B[1]) < 0 && side(B[0], B[1], A[0]) * side(B[0], B[1], A[1]) < 0) ++k;
+    }
+  const auto regions = geom::face_regions(planar_face(), cuts, all);
+  double sum = 0;
+  for (const auto& r : regions) sum += geom::area(r.surface);
+  std::printf("random chords: %zu chords, %d crossings, %zu regions (expected %zu), areas sum %.17g\n", seg.size(), k,
+              regions.size(), 1 + seg.size() + static_cast<std::size_t>(k), sum);
+  CHECK(regions.size() == 1 + seg.size() + static_cast<std::size_t>(k));
+  CHECK(std::abs(sum - 6) <= 1e-12 * 6);
 }
