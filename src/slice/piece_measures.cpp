@@ -9,7 +9,6 @@
 
 #include "patch_quadrature.hpp"
 #include "trivox/error.hpp"
-#include "trivox/geom/quadrature.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/spline/extract.hpp"
 
