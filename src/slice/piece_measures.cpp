@@ -168,10 +168,16 @@ PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceM
   // Coplanar faces of two sources: boundary_faces classifies them whole (no intersection curve
   // cuts them), so a shared region would be kept twice or not at all; refused here before the
   // intersections (geom::face_trim can be slow to refuse the thin regions they leave).
+  // Cells of one `without` list are one solid: their shared faces are coplanar by construction
+  // and boundary_faces handles them, so only faces of different solids are compared.
   std::vector<const vmodel::VCell*> src{&c};
-  for (const auto& w : c.within) src.push_back(&w);
-  for (const auto& list : c.without)
-    for (const auto& w : list) src.push_back(&w);
+  std::vector<int> solid{0};
+  for (const auto& w : c.within) src.push_back(&w), solid.push_back(static_cast<int>(solid.size()));
+  int next = static_cast<int>(solid.size());
+  for (const auto& list : c.without) {
+    for (const auto& w : list) src.push_back(&w), solid.push_back(next);
+    ++next;
+  }
   if (static_cast<int>(src.size()) - 1 > options.max_conditions)
     throw Error("piece_measures: cell " + std::to_string(cell) + " (" + c.name + ") has " + std::to_string(src.size() - 1) +
                     " direct conditions; expected at most " + std::to_string(options.max_conditions) +
@@ -182,7 +188,8 @@ PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceM
   for (std::size_t k = 0; k < src.size(); ++k)
     for (std::size_t f = 0; f < 6; ++f) planes[k][f] = plane_of(spline::boundary_face(src[k]->volume, spline::all_faces[f]), eps);
   for (std::size_t k = 0; k < src.size(); ++k)
-    for (std::size_t j = k + 1; j < src.size(); ++j)
+    for (std::size_t j = k + 1; j < src.size(); ++j) {
+      if (solid[j] == solid[k]) continue;
       for (std::size_t f = 0; f < 6; ++f)
         for (std::size_t g = 0; g < 6; ++g)
           if (coincide(planes[k][f], planes[j][g], eps))
@@ -191,6 +198,7 @@ PieceMeasures piece_measures(const vmodel::VModel& model, int cell, const PieceM
                             std::string(spline::face_name(spline::all_faces[g])) + " of '" + src[j]->name +
                             "' are coplanar and overlap; expected faces that cross or miss (coincident faces are not cut)",
                         ErrorKind::failed);
+    }
   return piece_measures(boundary_faces(model, cell, options.faces), cell, options);
 }
 

@@ -348,3 +348,26 @@ TEST_CASE("measures refuse more conditions than allowed", "[piece_measures]") {
   o.max_conditions = 1;
   CHECK(std::abs(slice::piece_measures(D, 0, o).volume - 3.5) <= 1e-12 * 3.5);
 }
+
+TEST_CASE("measures of a box minus a multi-cell cylinder", "[piece_measures]") {
+  // C: construct's 5-cell cylinder (r 0.5 about the z axis, z in [-1, 2]); its cells are
+  // prisms, so the part in A = [-1, 1]^2 x [0, 1] is a third of its volume (the cells' own
+  // quadrature). vol(A - C) + vol(A n C) = vol(A) = 4.
+  const VModel A = box("A", {-1, -1, 0}, {1, 1, 1});
+  VModel C;
+  C.properties = {"r"};
+  for (auto& c : construct::build_primitive("C", construct::Cylinder{{0, 0, -1}, {0, 0, 1}, 0.5, 3})) {
+    // xyz only: append the property coordinate A carries.
+    std::vector<double> pts;
+    const auto src = c.volume.points();
+    for (std::size_t i = 0; i < src.size(); i += 3) pts.insert(pts.end(), {src[i], src[i + 1], src[i + 2], 0.5});
+    C.cells.push_back({c.name, spline::Trivariate(c.volume.knot_vectors(), 4, pts)});
+  }
+  double vc = 0;
+  for (const auto& c : C.cells) vc += geom::volume(c.volume);
+  const VModel D = vmodel::boolean(A, C, BooleanOp::subtraction), I = vmodel::boolean(A, C, BooleanOp::intersection);
+  const double d = total_volume(D), i = total_volume(I);
+  std::printf("box minus 5-cell cylinder: %.17g, intersection %.17g (vol(C) / 3 = %.17g), sum %.17g (4)\n", d, i, vc / 3, d + i);
+  CHECK(std::abs(d + i - 4) <= 1e-8 * 4);
+  CHECK(std::abs(i - vc / 3) <= 1e-8 * vc);
+}
