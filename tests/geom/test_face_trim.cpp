@@ -107,6 +107,18 @@ double total(const std::vector<geom::TrimmedSurface>& s) {
   return a;
 }
 
+/// Two runs gave the same regions: interior points and loops, piece for piece.
+void same_regions(const std::vector<geom::FaceRegion>& again, const std::vector<geom::FaceRegion>& regions) {
+  REQUIRE(again.size() == regions.size());
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    CHECK(again[i].u == regions[i].u);
+    CHECK(again[i].v == regions[i].v);
+    REQUIRE(again[i].surface.loops().size() == regions[i].surface.loops().size());
+    for (std::size_t k = 0; k < regions[i].surface.loops().size(); ++k)
+      CHECK(again[i].surface.loops()[k].pieces == regions[i].surface.loops()[k].pieces);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("trim_face: a square hole in a planar face", "[face_trim]") {
@@ -208,15 +220,7 @@ TEST_CASE("trim_face: the regions tile a curved face", "[face_trim]") {
   CHECK(regions[3].surface.loops().size() == 2);
   CHECK(regions[4].surface.loops().size() == 1);
   // Determinism.
-  const auto again = geom::face_regions(f, cuts, [](const double*) { return true; });
-  REQUIRE(again.size() == regions.size());
-  for (std::size_t i = 0; i < regions.size(); ++i) {
-    CHECK(again[i].u == regions[i].u);
-    CHECK(again[i].v == regions[i].v);
-    REQUIRE(again[i].surface.loops().size() == regions[i].surface.loops().size());
-    for (std::size_t k = 0; k < regions[i].surface.loops().size(); ++k)
-      CHECK(again[i].surface.loops()[k].pieces == regions[i].surface.loops()[k].pieces);
-  }
+  same_regions(geom::face_regions(f, cuts, [](const double*) { return true; }), regions);
 }
 
 TEST_CASE("trim_face: refusals", "[face_trim]") {
@@ -350,15 +354,7 @@ TEST_CASE("trim_face: a circle of four arcs crossed by a line", "[face_trim]") {
     check_regions(regions, [](double u, double v) { return std::hypot(u - 0.5, v - 0.5) < 0.3 ? half : 0.5 - half; },
                   a0 > 0 ? "circle crossed inside arcs" : "circle crossed at arc ends");
     // Determinism: the same regions, points and loops again.
-    const auto again = geom::face_regions(planar_face(), cuts, all);
-    REQUIRE(again.size() == regions.size());
-    for (std::size_t i = 0; i < regions.size(); ++i) {
-      CHECK(again[i].u == regions[i].u);
-      CHECK(again[i].v == regions[i].v);
-      REQUIRE(again[i].surface.loops().size() == regions[i].surface.loops().size());
-      for (std::size_t k = 0; k < regions[i].surface.loops().size(); ++k)
-        CHECK(again[i].surface.loops()[k].pieces == regions[i].surface.loops()[k].pieces);
-    }
+    same_regions(geom::face_regions(planar_face(), cuts, all), regions);
   }
 }
 

@@ -28,6 +28,7 @@
 #include "trivox/slice/boundary_faces.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/vmodel/boolean.hpp"
+#include "boundary_fixtures.hpp"
 
 using namespace trivox;
 using vmodel::BooleanOp;
@@ -50,16 +51,6 @@ VModel primitive(const construct::Primitive& p) {
   VModel m;
   for (auto& c : construct::build_primitive("p", p)) m.cells.push_back({c.name, std::move(c.volume)});
   return m;
-}
-
-double model_boundary(const VModel& m, std::vector<slice::BoundaryFace>* all = nullptr) {
-  double a = 0;
-  for (int c = 0; c < static_cast<int>(m.cells.size()); ++c) {
-    auto f = slice::boundary_faces(m, c);
-    a += slice::boundary_area(f);
-    if (all) all->insert(all->end(), f.begin(), f.end());
-  }
-  return a;
 }
 
 /// Along the iso-curve of surface f at fixed parameter `fixed` in direction 1 - dir (running in
@@ -88,14 +79,11 @@ void add_section(const spline::Surface& f, int dir, double fixed, double z0, Sec
   }
 }
 
-}  // namespace
-
-TEST_CASE("boundary faces of a box minus the 5-cell cylinder through it", "[boundary_faces][junctions]") {
-  const VModel A = unit_box();
-  const VModel C = primitive(construct::Cylinder{{0, 0, -1}, {0, 0, 1}, 0.5, 3});
-  REQUIRE(C.cells.size() == 5);
-  // The cross-section (the lateral faces are extrusions along z, so any height serves; here the
-  // middle, z = 0.5) from the outer cells' u1 faces, v counter-clockwise about z.
+/// The cross-section of a construct cylinder along z at its middle height, z = 0.5 for both
+/// cylinders here (z_off measures the distance from it), from its outer cells'
+/// u1 faces (v counter-clockwise about z; the lateral faces are extrusions along z, so any height
+/// serves).
+Section cylinder_section(const VModel& C) {
   Section sec;
   for (const auto& c : C.cells) {
     if (c.name == "p.core") continue;
@@ -103,13 +91,23 @@ TEST_CASE("boundary faces of a box minus the 5-cell cylinder through it", "[boun
     const auto wd = f.domain(1);
     add_section(f, 0, 0.5 * (wd[0] + wd[1]), 0.5, sec);
   }
+  return sec;
+}
+
+}  // namespace
+
+TEST_CASE("boundary faces of a box minus the 5-cell cylinder through it", "[boundary_faces][junctions]") {
+  const VModel A = unit_box();
+  const VModel C = primitive(construct::Cylinder{{0, 0, -1}, {0, 0, 1}, 0.5, 3});
+  REQUIRE(C.cells.size() == 5);
+  const Section sec = cylinder_section(C);
   const double pi = std::acos(-1.0);
   REQUIRE(std::abs(sec.area - pi * 0.25) < 1e-3);
   REQUIRE(sec.z_off < 1e-12);
   const VModel D = vmodel::boolean(A, C, BooleanOp::subtraction);
   REQUIRE(D.cells.size() == 1);
   std::vector<slice::BoundaryFace> faces;
-  const double d = model_boundary(D, &faces);
+  const double d = test::cells_boundary_area(D, &faces);
   double top = 0, wall = 0;
   int walls = 0;
   for (const auto& f : faces) {
@@ -137,17 +135,11 @@ TEST_CASE("boundary faces of a box minus the 5-cell cylinder inside it", "[bound
   // other face of the cells is shared by two of them and lies inside C.
   const VModel A = unit_box();
   const VModel C = primitive(construct::Cylinder{{0, 0, 0.25}, {0, 0, 1}, 0.5, 0.5});
-  Section sec;
-  for (const auto& c : C.cells) {
-    if (c.name == "p.core") continue;
-    const auto f = spline::boundary_face(c.volume, spline::Face::u1);
-    const auto wd = f.domain(1);
-    add_section(f, 0, 0.5 * (wd[0] + wd[1]), 0.5, sec);
-  }
+  const Section sec = cylinder_section(C);
   REQUIRE(sec.z_off < 1e-12);
   const VModel D = vmodel::boolean(A, C, BooleanOp::subtraction);
   std::vector<slice::BoundaryFace> faces;
-  const double d = model_boundary(D, &faces);
+  const double d = test::cells_boundary_area(D, &faces);
   double own = 0, lids = 0, wall = 0;
   for (const auto& f : faces) {
     if (f.source == -1) own += f.area;
