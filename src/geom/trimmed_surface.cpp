@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "patch_quadrature.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/planar_crossing.hpp"
 #include "trivox/geom/quadrature.hpp"
@@ -663,6 +664,21 @@ double area_rule(const spline::Surface& s, int coord, int extra) {
   check_order(s.orders()[0], lim, "surface of orders (" + std::to_string(s.orders()[0]) + ", " + std::to_string(s.orders()[1]) + ")");
   check_order(s.orders()[1], lim, "surface of orders (" + std::to_string(s.orders()[0]) + ", " + std::to_string(s.orders()[1]) + ")");
   extra = std::clamp(extra, 0, 64);
+  if (coord < 3) {
+    // Area and the xyz integrals: the Gauss points of detail::patch_points (Bernstein tables on
+    // Bezier patches, as untrim makes them).
+    detail::PatchRules rules;
+    std::vector<detail::PatchPoint> pts;
+    detail::patch_points(s, [extra](int order) { return order + extra; }, rules, pts);
+    double total = 0.0;
+    for (const auto& q : pts) {
+      const auto &a = q.xs, &b = q.xt;
+      const double f = coord < 0 ? 1.0 : q.x[static_cast<std::size_t>(coord)];
+      total += q.w * f * std::hypot(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]);
+    }
+    return total;
+  }
+  // A property coordinate: evaluated per Gauss point.
   const auto ru = gauss_legendre(s.orders()[0] + extra), rv = gauss_legendre(s.orders()[1] + extra);
   const int k = s.dim();
   double total = 0.0;

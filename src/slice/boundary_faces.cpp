@@ -4,7 +4,6 @@
 #include <memory>
 #include <utility>
 
-#include "patch_quadrature.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/face_trim.hpp"
 #include "trivox/geom/quadrature.hpp"
@@ -63,8 +62,6 @@ std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell, 
   std::vector<int> side(n);
   for (std::size_t k = 0; k < n; ++k)
     side[k] = (geom::signed_volume(src[k].volume) < 0 ? -1 : 1) * (is_within[k] ? 1 : -1);
-  detail::PatchRules rules;
-  std::vector<detail::PatchPoint> pts;
   geom::IntersectionOptions io;
   io.tolerance = options.intersection_tolerance;
   std::vector<BoundaryFace> out;
@@ -85,15 +82,7 @@ std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell, 
                      " face " + std::string(spline::face_name(spline::all_faces[f]));
       for (auto& ts : geom::trim_face(F, cuts, [&](const double* x) { return admitted(k, x); }, fo)) {
         geom::Untrimmed patches = geom::untrim(ts);
-        // geom::area's rule (order + 8 Gauss points per direction) on the Bezier tables.
-        double a = 0;
-        for (const auto& p : patches.patches) {
-          detail::patch_points(p, [](int order) { return order + 8; }, rules, pts);
-          for (const auto& q : pts) {
-            const auto &xs = q.xs, &xt = q.xt;
-            a += q.w * std::hypot(xs[1] * xt[2] - xs[2] * xt[1], xs[2] * xt[0] - xs[0] * xt[2], xs[0] * xt[1] - xs[1] * xt[0]);
-          }
-        }
+        const double a = geom::area(patches);
         out.push_back({.cell = cell,
                        .source = static_cast<int>(k) - 1,
                        .source_name = src[k].name,

@@ -7,10 +7,11 @@
 #include <string>
 #include <utility>
 
-#include "patch_quadrature.hpp"
+#include "../geom/patch_quadrature.hpp"
 #include "trivox/error.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/spline/extract.hpp"
+#include "trivox/spline/refine.hpp"
 
 namespace trivox::slice {
 
@@ -25,9 +26,9 @@ struct Sums {
 
 /// Adds a patch's integrands at its Gauss points, 2 x order per direction: x_i^2 n_i has
 /// degree 4p - 1 in a direction of degree p, which 2p + 2 points integrate exactly.
-void integrate(const spline::Surface& p, int sign, const std::array<double, 3>& c, detail::PatchRules& rules,
-               std::vector<detail::PatchPoint>& pts, Sums& s) {
-  detail::patch_points(p, [](int order) { return 2 * order; }, rules, pts);
+void integrate(const spline::Surface& p, int sign, const std::array<double, 3>& c, geom::detail::PatchRules& rules,
+               std::vector<geom::detail::PatchPoint>& pts, Sums& s) {
+  geom::detail::patch_points(p, [](int order) { return 2 * order; }, rules, pts);
   for (const auto& q : pts) {
     const auto &xs = q.xs, &xt = q.xt;
     const double n[3] = {xs[1] * xt[2] - xs[2] * xt[1], xs[2] * xt[0] - xs[0] * xt[2], xs[0] * xt[1] - xs[1] * xt[0]};
@@ -41,43 +42,27 @@ void integrate(const spline::Surface& p, int sign, const std::array<double, 3>& 
   }
 }
 
-/// A Bezier patch's coefficients of one coordinate: ns x nt, s fastest.
-struct Grid {
-  int ns = 0, nt = 0;
-  std::vector<double> a;
-  double at(int i, int j) const { return a[static_cast<std::size_t>(i + ns * j)]; }
-};
-
-/// Halves g at 1/2 in direction dir by de Casteljau.
-std::pair<Grid, Grid> halve(const Grid& g, int dir) {
-  Grid lo = g, hi = g;
-  const int n = dir == 0 ? g.ns : g.nt, m = dir == 0 ? g.nt : g.ns;
-  std::vector<double> b(static_cast<std::size_t>(n));
-  for (int r = 0; r < m; ++r) {
-    auto idx = [&](int k) { return static_cast<std::size_t>(dir == 0 ? k + g.ns * r : r + g.ns * k); };
-    for (int k = 0; k < n; ++k) b[static_cast<std::size_t>(k)] = g.a[idx(k)];
-    for (int level = 0; level < n; ++level) {
-      lo.a[idx(level)] = b[0];
-      hi.a[idx(n - 1 - level)] = b[static_cast<std::size_t>(n - 1 - level)];
-      for (int k = 0; k + 1 < n - level; ++k)
-        b[static_cast<std::size_t>(k)] = 0.5 * (b[static_cast<std::size_t>(k)] + b[static_cast<std::size_t>(k + 1)]);
-    }
-  }
-  return {std::move(lo), std::move(hi)};
+/// The largest of a scalar patch's corner coefficients (points on a clamped patch).
+double corner_max(const spline::Surface& g) {
+  const auto& a = g.points();
+  const std::size_t ns = static_cast<std::size_t>(g.count(0)), n = a.size();
+  return std::max({a[0], a[ns - 1], a[n - ns], a[n - 1]});
 }
 
-/// Raises `best` to the maximum of the patch g within tol (branch and bound); false when the
-/// budget ran out (best then also holds the remaining coefficient bounds).
-bool patch_max(const Grid& g, double tol, int budget, double& best) {
-  std::vector<Grid> stack{g};
+/// Raises `best` to the maximum of the scalar Bezier patch g within tol (branch and bound on
+/// the coefficients' convex hull, halving by spline::split); false when the budget ran out
+/// (best then also holds the remaining coefficient bounds).
+bool patch_max(const spline::Surface& g, double tol, int budget, double& best) {
+  std::vector<spline::Surface> stack{g};
   double bound = -std::numeric_limits<double>::infinity();
   bool tight = true;
   while (!stack.empty()) {
-    Grid h = std::move(stack.back());
+    spline::Surface h = std::move(stack.back());
     stack.pop_back();
-    const double m = *std::max_element(h.a.begin(), h.a.end());
+    const auto& a = h.points();
+    const double m = *std::max_element(a.begin(), a.end());
     if (m <= best + tol) continue;
-    best = std::max({best, h.at(0, 0), h.at(h.ns - 1, 0), h.at(0, h.nt - 1), h.at(h.ns - 1, h.nt - 1)});
+    best = std::max(best, corner_max(h));
     if (m <= best + tol) continue;
     if (budget-- <= 0) {
       bound = std::max(bound, m);
@@ -85,12 +70,16 @@ bool patch_max(const Grid& g, double tol, int budget, double& best) {
       continue;
     }
     // Split across the direction along which the coefficients vary most.
+    const int ns = h.count(0), nt = h.count(1);
+    auto at = [&](int i, int j) { return a[static_cast<std::size_t>(i + ns * j)]; };
     double vs = 0, vt = 0;
-    for (int j = 0; j < h.nt; ++j)
-      for (int i = 0; i + 1 < h.ns; ++i) vs = std::max(vs, std::abs(h.at(i + 1, j) - h.at(i, j)));
-    for (int j = 0; j + 1 < h.nt; ++j)
-      for (int i = 0; i < h.ns; ++i) vt = std::max(vt, std::abs(h.at(i, j + 1) - h.at(i, j)));
-    auto [lo, hi] = halve(h, vs >= vt ? 0 : 1);
+    for (int j = 0; j < nt; ++j)
+      for (int i = 0; i + 1 < ns; ++i) vs = std::max(vs, std::abs(at(i + 1, j) - at(i, j)));
+    for (int j = 0; j + 1 < nt; ++j)
+      for (int i = 0; i < ns; ++i) vt = std::max(vt, std::abs(at(i, j + 1) - at(i, j)));
+    const int dir = vs >= vt ? 0 : 1;
+    const auto d = h.domain(dir);
+    auto [lo, hi] = spline::split(h, dir, 0.5 * (d[0] + d[1]));
     stack.push_back(std::move(lo));
     stack.push_back(std::move(hi));
   }
@@ -226,8 +215,8 @@ PieceMeasures piece_measures(const std::vector<BoundaryFace>& faces, int cell, c
   diag = std::sqrt(diag);
 
   Sums s;
-  detail::PatchRules rules;
-  std::vector<detail::PatchPoint> pts;
+  geom::detail::PatchRules rules;
+  std::vector<geom::detail::PatchPoint> pts;
   for (const auto& f : faces) {
     r.area += f.area;
     for (const auto& p : f.patches.patches) integrate(p, f.orientation, c, rules, pts, s);
@@ -257,20 +246,22 @@ PieceMeasures piece_measures(const std::vector<BoundaryFace>& faces, int cell, c
   for (std::size_t k = 0; k < 3; ++k)
     for (int side = 0; side < 2; ++side) {
       const double sg = side ? 1.0 : -1.0;  // maximise sg * x_k
-      std::vector<Grid> grids;
+      std::vector<spline::Surface> grids;
       double best = -std::numeric_limits<double>::infinity();
       for (const auto& f : faces)
         for (const auto& p : f.patches.patches) {
-          Grid g{p.count(0), p.count(1), {}};
+          std::vector<double> a;
           const auto pts = p.points();
-          for (std::size_t q = 0; q < pts.size(); q += static_cast<std::size_t>(p.dim())) g.a.push_back(sg * pts[q + k]);
-          best = std::max({best, g.at(0, 0), g.at(g.ns - 1, 0), g.at(0, g.nt - 1), g.at(g.ns - 1, g.nt - 1)});
-          // A patch of several spans (not what untrim makes): its coefficients bound it, but its
-          // corner coefficients need not lie on it, so take the conservative bound.
+          for (std::size_t q = 0; q < pts.size(); q += static_cast<std::size_t>(p.dim())) a.push_back(sg * pts[q + k]);
+          spline::Surface g({p.knots(0), p.knots(1)}, 1, std::move(a));
+          best = std::max(best, corner_max(g));
+          // A patch of several spans (not what untrim makes): its coefficients bound it; take
+          // that conservative bound rather than subdividing.
           if (p.count(0) != p.orders()[0] || p.count(1) != p.orders()[1]) {
-            g.a = {*std::max_element(g.a.begin(), g.a.end())};
-            g.ns = g.nt = 1;
+            const auto& c = g.points();
+            best = std::max(best, *std::max_element(c.begin(), c.end()));
             r.bbox_tight = false;
+            continue;
           }
           grids.push_back(std::move(g));
         }

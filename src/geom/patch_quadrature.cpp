@@ -4,12 +4,12 @@
 
 #include "trivox/geom/quadrature.hpp"
 
-namespace trivox::slice::detail {
+namespace trivox::geom::detail {
 
 const BernsteinRule& PatchRules::get(int order, int points) {
   const auto key = std::make_pair(order, points);
   if (const auto it = rules_.find(key); it != rules_.end()) return it->second;
-  const geom::GaussRule g = geom::gauss_legendre(points);
+  const GaussRule g = gauss_legendre(points);
   BernsteinRule r;
   const int p = order - 1;
   const auto o = static_cast<std::size_t>(order);
@@ -72,7 +72,7 @@ void bezier_points(const spline::Surface& p, int ns, int nt, PatchRules& rules, 
 }
 
 void spline_points(const spline::Surface& p, int ns, int nt, std::vector<PatchPoint>& out) {
-  const geom::GaussRule gs = geom::gauss_legendre(ns), gt = geom::gauss_legendre(nt);
+  const GaussRule gs = gauss_legendre(ns), gt = gauss_legendre(nt);
   const auto dim = static_cast<std::size_t>(p.dim());
   std::vector<double> d(3 * dim);
   auto spans = [](const spline::KnotVector& k) {
@@ -96,4 +96,4 @@ void spline_points(const spline::Surface& p, int ns, int nt, std::vector<PatchPo
     }
 }
 
-}  // namespace trivox::slice::detail
+}  // namespace trivox::geom::detail

@@ -1,6 +1,6 @@
-// Tensor Gauss points of a surface patch with its xyz and first partials there, for the
-// integrals of slice's boundary faces (areas, slice/boundary_faces.hpp; volumes and moments,
-// slice/piece_measures.hpp). A Bezier patch on [0, 1]^2 (what geom::untrim makes) is evaluated
+// Tensor Gauss points of a surface patch with its xyz and first partials there, for surface
+// integrals: areas and coordinate integrals (geom/trimmed_surface.hpp), volumes and moments of
+// Boolean pieces (slice/piece_measures.hpp). A Bezier patch on [0, 1]^2 (what geom::untrim makes) is evaluated
 // from Bernstein tables at the nodes, contracted along t first: O(n_t o_s o_t + n_s n_t o_s)
 // per patch for orders o and n nodes, against a general evaluation per node. Any other patch
 // is evaluated per knot span with TensorSpline::eval_derivatives.
@@ -11,7 +11,7 @@
 
 #include "trivox/spline/tensor_spline.hpp"
 
-namespace trivox::slice::detail {
+namespace trivox::geom::detail {
 
 struct PatchPoint {
   std::array<double, 3> x, xs, xt;  ///< X, dX/ds, dX/dt (xyz)
@@ -57,4 +57,4 @@ void patch_points(const spline::Surface& p, Points points, PatchRules& rules, st
     spline_points(p, ns, nt, out);
 }
 
-}  // namespace trivox::slice::detail
+}  // namespace trivox::geom::detail
