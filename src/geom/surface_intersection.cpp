@@ -218,6 +218,115 @@ double polyline_distance(const std::vector<IntersectionPoint>& pts, const std::a
   return best;
 }
 
+/// The signed gap, along the unit normal n at p, between surface a at the point of its tangent
+/// plane offset by `offset` from p (mapped to a's parameters by its first derivatives) and
+/// surface b; nullopt where either point falls outside its parameter rectangle or the solve for
+/// b's point on a's normal line does not converge.
+std::optional<double> normal_gap(const Surface& a, const Surface& b, const IntersectionPoint& p, const V3& n,
+                                 const V3& offset, double tol, std::vector<double>& buf) {
+  const Frame f1 = frame(a, p.uv1, buf);
+  Eigen::Matrix<double, 3, 2> A1;
+  A1 << f1.du, f1.dv;
+  const Eigen::Vector2d d1 = A1.colPivHouseholderQr().solve(offset);
+  const std::array<double, 2> uv1{p.uv1[0] + d1(0), p.uv1[1] + d1(1)};
+  const Box2 da = domain_of(a), db = domain_of(b);
+  for (std::size_t k = 0; k < 2; ++k)
+    if (!(uv1[k] >= da.lo[k] && uv1[k] <= da.hi[k])) return std::nullopt;
+  const Frame x1 = frame(a, uv1, buf);
+  // b(s, t) = X + g n: three equations in s, t, g.
+  std::array<double, 2> uv2 = p.uv2;
+  {
+    const Frame f2 = frame(b, uv2, buf);
+    Eigen::Matrix<double, 3, 2> A2;
+    A2 << f2.du, f2.dv;
+    const Eigen::Vector2d d2 = A2.colPivHouseholderQr().solve(x1.x - f2.x);
+    uv2 = {uv2[0] + d2(0), uv2[1] + d2(1)};
+  }
+  double g = 0.0;
+  for (int it = 0; it < 30; ++it) {
+    for (std::size_t k = 0; k < 2; ++k)
+      if (!(uv2[k] >= db.lo[k] && uv2[k] <= db.hi[k])) return std::nullopt;
+    const Frame f2 = frame(b, uv2, buf);
+    const V3 F = f2.x - x1.x - g * n;
+    if (F.norm() < 0.1 * tol) return g;
+    Eigen::Matrix3d J;
+    J << f2.du, f2.dv, -n;
+    const Eigen::Vector3d step = J.fullPivLu().solve(-F);
+    if (!step.allFinite()) return std::nullopt;
+    uv2 = {uv2[0] + step(0), uv2[1] + step(1)};
+    g += step(2);
+  }
+  return std::nullopt;
+}
+
+/// What surfaces a and b do around p, a point of both where their normals are (nearly) parallel:
+/// the normal gap between them at distance r from p in 16 directions of a's tangent plane (those
+/// inside both parameter rectangles) is fitted by g = r (D c + E s) + r^2 / 2 (A c^2 + 2 B c s +
+/// C s^2), c and s the direction's cosine and sine: the first-order term is the angle between the
+/// surfaces, the quadratic form the difference of their second fundamental forms along the
+/// common normal, whose rank tells the kind of contact (Patrikalakis & Maekawa 2002, Ch. 6,
+/// tangential intersection curves). All gaps within 10 tol: the surfaces coincide around p
+/// (region). A first-order term above a tenth of the largest gap: they cross at an angle (no
+/// contact). The form indefinite: they cross along two curves through p (no contact). Otherwise
+/// the form's smaller eigenvalue decides: within 1e-3 of the larger one (plus 10 tol in gap), the
+/// surfaces touch along a curve through p, whose direction the gap grows in as r^4 only (curve);
+/// else at p alone (point). nullopt also where fewer than 5 directions could be probed.
+std::optional<IntersectionContact::Kind> classify_contact(const Surface& a, const Surface& b, const IntersectionPoint& p,
+                                                          double r, double tol) {
+  std::vector<double> buf;
+  const Frame f1 = frame(a, p.uv1, buf);
+  const V3 n = f1.du.cross(f1.dv).normalized(), e1 = f1.du.normalized(), e2 = n.cross(e1);
+  if (!n.allFinite() || !e1.allFinite()) return std::nullopt;
+  Eigen::Matrix<double, 5, 5> N = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> rhs = Eigen::Matrix<double, 5, 1>::Zero();
+  double largest = 0.0;
+  int valid = 0;
+  for (int k = 0; k < 16; ++k) {
+    const double th = k * M_PI / 8, c = std::cos(th), s = std::sin(th);
+    const auto g = normal_gap(a, b, p, n, r * (c * e1 + s * e2), tol, buf);
+    if (!g) continue;
+    ++valid;
+    largest = std::max(largest, std::abs(*g));
+    // Unknowns scaled to gaps: D r, E r, A r^2 / 2, B r^2, C r^2 / 2.
+    Eigen::Matrix<double, 5, 1> row;
+    row << c, s, c * c, c * s, s * s;
+    N += row * row.transpose();
+    rhs += row * *g;
+  }
+  if (valid < 5) return std::nullopt;
+  if (largest <= 10 * tol) return IntersectionContact::Kind::region;
+  const Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 5, 5>> qr(N);
+  if (qr.rank() < 5) return std::nullopt;
+  const Eigen::Matrix<double, 5, 1> q = qr.solve(rhs);
+  if (std::hypot(q(0), q(1)) > 0.1 * largest) return std::nullopt;  // crossing at an angle
+  Eigen::Matrix2d form;  // in gap units: g = v^T form v for unit directions v
+  form << q(2), 0.5 * q(3), 0.5 * q(3), q(4);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(form);
+  const Eigen::Vector2d lam = eig.eigenvalues();
+  const int null = std::abs(lam(0)) <= std::abs(lam(1)) ? 0 : 1;
+  const double small = std::abs(lam(null)), big = std::abs(lam(1 - null));
+  const double threshold = 1e-3 * big + 10 * tol;
+  if (small <= threshold) return IntersectionContact::Kind::curve;
+  if (lam(0) * lam(1) < 0) return std::nullopt;  // crossing along two curves
+  return IntersectionContact::Kind::point;
+}
+
+/// The largest sine of the angle between the surfaces' normals over c's points: small (about
+/// sqrt(tol x curvature)) on a curve traced along a tangential contact, whose points lie within
+/// the tolerance of both surfaces only near the contact.
+double largest_normal_angle(const Surface& a, const Surface& b, const IntersectionCurve& c) {
+  std::vector<double> buf1, buf2;
+  double best = 0.0;
+  for (const auto& p : c.points) {
+    const Frame f1 = frame(a, p.uv1, buf1), f2 = frame(b, p.uv2, buf2);
+    const V3 n1 = f1.du.cross(f1.dv), n2 = f2.du.cross(f2.dv);
+    const double scale = n1.norm() * n2.norm();
+    if (!(scale > 0)) continue;
+    best = std::max(best, n1.cross(n2).norm() / scale);
+  }
+  return best;
+}
+
 /// One branch from `start` in direction `sign`. Returns the points after start; `closed` when
 /// the branch came back to start.
 std::vector<IntersectionPoint> march(const Solver& solver, const IntersectionPoint& start, double sign, double hmax,
@@ -305,10 +414,12 @@ std::vector<IntersectionPoint> march(const Solver& solver, const IntersectionPoi
   return out;
 }
 
-/// Cubic interpolation of the points (chord length), closing the loop for closed curves.
-void fit_curves(IntersectionCurve& c, double tol) {
-  // Points closer than the tolerance (a boundary end right after a step) would repeat a
-  // parameter: dropped, keeping the ends.
+/// Drops points closer than 10 tolerances to the one kept before them (a boundary end right
+/// after a step would repeat a chord-length parameter), keeping the last point of an open
+/// branch, and a closed branch's last point where it repeats the first. A closed branch left with
+/// fewer than 3 points is no loop: open. Returns the number of points left; fewer than 2 means
+/// the branch is a single point (its points all lie within 10 tolerances of one another).
+std::size_t drop_repeated(IntersectionCurve& c, double tol) {
   std::vector<IntersectionPoint> pts;
   for (std::size_t i = 0; i < c.points.size(); ++i) {
     if (!pts.empty() && dist(pts.back(), c.points[i]) <= 10 * tol) {
@@ -317,36 +428,56 @@ void fit_curves(IntersectionCurve& c, double tol) {
     }
     pts.push_back(c.points[i]);
   }
-  c.points = pts;
-  if (c.closed) {
-    if (pts.size() > 2 && dist(pts.back(), pts.front()) <= 10 * tol) pts.pop_back(), c.points.pop_back();
-    pts.push_back(pts.front());
+  if (c.closed && pts.size() > 2 && dist(pts.back(), pts.front()) <= 10 * tol) pts.pop_back();
+  if (pts.size() < 3) c.closed = false;
+  c.points = std::move(pts);
+  return c.points.size();
+}
+
+/// The chord-length parameters of c's points (the first point repeated at the end of a closed
+/// branch); c has at least 2 distinct consecutive points (drop_repeated).
+std::vector<double> chord_params(const IntersectionCurve& c) {
+  std::vector<double> v;
+  for (const auto& p : c.points) v.insert(v.end(), p.xyz.begin(), p.xyz.end());
+  if (c.closed) v.insert(v.end(), c.points.front().xyz.begin(), c.points.front().xyz.end());
+  return spline::chord_length_params(v, 3);
+}
+
+/// Cubic interpolation of the points (chord length), closing the loop for closed curves.
+/// False (and no curves) when the branch is a single point.
+bool fit_curves(IntersectionCurve& c, double tol) {
+  if (drop_repeated(c, tol) < 2) {
+    c.xyz = c.uv1 = c.uv2 = {};
+    return false;
   }
-  if (pts.size() < 2) return;
+  std::vector<IntersectionPoint> pts = c.points;
+  if (c.closed) pts.push_back(pts.front());
   std::vector<double> xyz, uv1, uv2;
   for (const auto& p : pts) {
     xyz.insert(xyz.end(), p.xyz.begin(), p.xyz.end());
     uv1.insert(uv1.end(), p.uv1.begin(), p.uv1.end());
     uv2.insert(uv2.end(), p.uv2.begin(), p.uv2.end());
   }
-  const auto t = spline::chord_length_params(xyz, 3);
+  const auto t = chord_params(c);
   for (int order = std::min<int>(4, static_cast<int>(pts.size())); order >= 2; --order) {
     try {
       const auto kv = spline::interpolation_knots(t, order);
       c.xyz = spline::interpolate_curve(t, 3, xyz, kv);
       c.uv1 = spline::interpolate_curve(t, 2, uv1, kv);
       c.uv2 = spline::interpolate_curve(t, 2, uv2, kv);
-      return;
+      return true;
     } catch (const Error&) {
       // Parameters too uneven for this order's averaged knots: one order lower (a polyline, order
       // 2, always interpolates distinct parameters).
     }
   }
+  return false;
 }
 
 }  // namespace
 
-std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surface& b, const IntersectionOptions& options) {
+std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surface& b, const IntersectionOptions& options,
+                                                  std::vector<IntersectionContact>* contacts) {
   if (a.dim() < 3 || b.dim() < 3)
     throw Error("surface intersection of surfaces with " + std::to_string(a.dim()) + " and " + std::to_string(b.dim()) +
                 " coordinates; expected at least 3 (xyz)");
@@ -366,11 +497,20 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
     for (const auto& c : out)
       if (polyline_distance(c.points, seed.xyz) < 0.75 * hmax) known = true;
     if (known) continue;
-    // Tangential contacts and coincident (overlapping) regions are not curves: skipped.
+    // Tangential contacts and coincident (overlapping) regions are not curves: skipped, and
+    // classified for the caller (one seed per 0.75 hmax, at most 32).
     {
       V3 T;
       Eigen::Vector4d dt;
-      if (!solver.tangent(seed, T, dt)) continue;
+      if (!solver.tangent(seed, T, dt)) {
+        if (!contacts || contacts->size() >= 32) continue;
+        bool near = false;
+        for (const auto& k : *contacts) near = near || dist(k.at, seed) < 0.75 * hmax;
+        if (near) continue;
+        if (const auto kind = classify_contact(a, b, seed, 0.05 * hmax, options.tolerance))
+          contacts->push_back({*kind, seed});
+        continue;
+      }
     }
     IntersectionCurve c;
     bool closed = false, closed_back = false;
@@ -381,19 +521,18 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
     c.points.push_back(seed);
     c.points.insert(c.points.end(), fwd.begin(), fwd.end());
     c.closed = closed;
-    // Densify until the xyz curve's midpoints lie on both surfaces.
-    for (int pass = 0; pass < 6 && c.points.size() >= 2; ++pass) {
-      fit_curves(c, options.tolerance);
+    // A branch whose points all lie within 10 tolerances of one another is a point: where the
+    // surfaces meet at a single point (rectangles touching at a corner or an edge's end, a
+    // tangential contact whose seed still had a tangent, a curve cut short at a singular point
+    // such as a pole). It bounds no region and is dropped; any curve through it is traced from
+    // its other seeds.
+    if (!fit_curves(c, options.tolerance)) continue;
+    // Densify until the xyz curve and both surfaces at the parameter-space curves' midpoints lie
+    // within the tolerance of the intersection.
+    for (int pass = 0; pass < 6; ++pass) {
       std::vector<IntersectionPoint> dense;
       bool all_good = true;
-      const auto t = spline::chord_length_params(
-          [&] {
-            std::vector<double> v;
-            for (const auto& p : c.points) v.insert(v.end(), p.xyz.begin(), p.xyz.end());
-            if (c.closed) v.insert(v.end(), c.points.front().xyz.begin(), c.points.front().xyz.end());
-            return v;
-          }(),
-          3);
+      const auto t = chord_params(c);
       const std::size_t n = c.points.size();
       for (std::size_t i = 0; i < n; ++i) {
         dense.push_back(c.points[i]);
@@ -409,15 +548,34 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
         k.n = V3(q.xyz[0] - c.points[i].xyz[0], q.xyz[1] - c.points[i].xyz[1], q.xyz[2] - c.points[i].xyz[2]).normalized();
         k.q = V3(x[0], x[1], x[2]);
         if (!solver.solve(m, k)) continue;
-        if (std::hypot(m.xyz[0] - x[0], m.xyz[1] - x[1], m.xyz[2] - x[2]) > options.tolerance) {
+        // The xyz curve and the images of both parameter-space curves (the trimming curves of the
+        // faces: what the faces are cut along) within the tolerance of the intersection point.
+        const auto x1 = a.eval({u1[0], u1[1]}), x2 = b.eval({u2[0], u2[1]});
+        const double off = std::max({std::hypot(m.xyz[0] - x[0], m.xyz[1] - x[1], m.xyz[2] - x[2]),
+                                     std::hypot(m.xyz[0] - x1[0], m.xyz[1] - x1[1], m.xyz[2] - x1[2]),
+                                     std::hypot(m.xyz[0] - x2[0], m.xyz[1] - x2[1], m.xyz[2] - x2[2])});
+        if (off > options.tolerance) {
           all_good = false;
           dense.push_back(m);
         }
       }
       if (all_good) break;
       c.points = std::move(dense);
+      // The points kept before stay (drop_repeated compares each point with the one kept before
+      // it), so the branch keeps at least its 2 points.
+      if (!fit_curves(c, options.tolerance)) break;
     }
-    if (c.points.size() >= 2) fit_curves(c, options.tolerance);
+    if (c.points.size() < 2 || c.xyz.dim() != 3) continue;
+    // A curve along which the normals stay within 1e-3 rad may be traced along a tangential
+    // contact: classified at its middle point. A point contact's traced curve is a small loop
+    // about the point within sqrt(tol / curvature) of it (where the surfaces are within the
+    // tolerance): dropped as a point. A curve contact keeps its curve and is reported.
+    if (largest_normal_angle(a, b, c) < 1e-3) {
+      const IntersectionPoint mid = c.points[c.points.size() / 2];
+      const auto kind = classify_contact(a, b, mid, 0.05 * hmax, options.tolerance);
+      if (kind == IntersectionContact::Kind::point) continue;
+      if (kind && contacts && contacts->size() < 32) contacts->push_back({*kind, mid});
+    }
     out.push_back(std::move(c));
   }
   return out;
