@@ -19,6 +19,16 @@
 /// (coincident) faces are not cut (intersect_surfaces reports no curve there) and are classified
 /// as a whole.
 ///
+/// Contacts (geom::IntersectionContact): where a face of one solid (the cell's trivariate, a
+/// `within` cell, or the cells of one `without` list) touches a face of another tangentially
+/// along a curve, or coincides with it over a region (curved faces too), boundary_faces throws
+/// naming both faces and the place: such faces are not cut there, so the piece would be
+/// non-manifold or wrong. Isolated point contacts bound nothing and are ignored; faces of one
+/// solid (the cells of a primitive) meet so by construction and are not checked. Cutting curves
+/// within the trimming tolerance of a point, or along a side of the face's parameter rectangle
+/// (where the cells of a primitive meet along edges; geom::trim_face sets those aside), are left
+/// out before trimming.
+///
 /// Each face carries its orientation: whether the piece's outward normal is S_u x S_v of the
 /// face's surface or its opposite (face_orientation below, times the sign of the source
 /// trivariate's Jacobian determinant, reversed for a `without` cell's face: the piece lies
@@ -76,7 +86,8 @@ struct BoundaryFaceOptions {
 
 /// The trimmed boundary faces of `model.cells[cell]`, in order: its own faces u0..w1, then each
 /// condition cell's faces u0..w1; the regions of one face in geom::face_regions order.
-/// @throws trivox::Error (bad_input) for a cell index out of range, and as geom::trim_face
+/// @throws trivox::Error (bad_input) for a cell index out of range; (failed) for faces of two
+///         solids touching along a curve or coinciding over a region; and as geom::trim_face
 std::vector<BoundaryFace> boundary_faces(const vmodel::VModel& model, int cell,
                                          const BoundaryFaceOptions& options = {});
 

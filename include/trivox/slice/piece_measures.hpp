@@ -20,9 +20,10 @@
 /// throws (a face missing or counted twice, such as coplanar faces of two inputs, which
 /// boundary_faces classifies whole, or a wrong orientation). Where the faces meet only within
 /// the intersection curves' accuracy both are small but not zero (about 1e-15 for planar cuts,
-/// 1e-7 where a plane cuts a bicubic sphere cell, whose parameter-space trimming curves leave
-/// the plane by up to about 1e-6); the volume's error is then of the order of spread x area x
-/// diagonal.
+/// 1e-11 to 1e-10 where planes and the curved cells of construct's ball, cylinder and torus cut
+/// one another, the faces' images of the parameter-space trimming curves lying within the
+/// intersection tolerance, 1e-10, of the intersection); the volume's error is then of the order of
+/// spread x area x diagonal.
 ///
 /// The boundary area is the sum of the faces' areas (geom::area: a square root integrand, so
 /// converged Gauss quadrature, not exact). The bounding box is that of the boundary patches,
