@@ -1,5 +1,6 @@
 // `trivox mesh MODEL -o FILE`: the boundary of a model as a closed triangle mesh with vertex
-// colours (vmodel/boundary_mesh.hpp), written as STL, PLY, OBJ or 3MF (io/mesh_file.hpp).
+// colours (vmodel/boundary_mesh.hpp; for models with trimmed cells, the pieces of Booleans,
+// slice/trimmed_mesh.hpp), written as STL, PLY, OBJ or 3MF (io/mesh_file.hpp).
 // Exit 1 when the mesh is not a closed manifold (nothing is written then).
 #include <unistd.h>
 
@@ -13,6 +14,7 @@
 #include "trivox/error.hpp"
 #include "trivox/io/mesh_file.hpp"
 #include "trivox/io/model_file.hpp"
+#include "trivox/slice/trimmed_mesh.hpp"
 #include "trivox/vmodel/boundary_mesh.hpp"
 
 namespace trivox::cli {
@@ -47,7 +49,7 @@ void add_mesh(CLI::App& app, Common& common) {
   auto opt = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand(
       "mesh", "The model's boundary as a closed, outward-oriented triangle mesh with vertex colours (STL, PLY, OBJ, 3MF)");
-  sub->add_option("MODEL", opt->model, "Model file (.json, or G+Smo .xml); cells must be untrimmed")->required();
+  sub->add_option("MODEL", opt->model, "Model file (.json, or G+Smo .xml); trimmed cells (Booleans) are meshed from their trimmed faces")->required();
   sub->add_option("-o,--output", opt->output, "Mesh file to write (.stl, .ply, .obj or .3mf; replaced if it exists)")
       ->required();
   sub->add_option("--tolerance", opt->tolerance,
@@ -73,9 +75,17 @@ void add_mesh(CLI::App& app, Common& common) {
     vmodel::MeshOptions mo;
     if (opt->tolerance) mo.tolerance = *opt->tolerance;
     mo.per_cell = opt->cells;
+    // Trimmed cells: their boundary is their trimmed faces, untrimmed into patches and welded.
+    const bool trimmed = slice::has_trimmed_cells(model);
     vmodel::BoundaryMesh mesh;
     try {
-      mesh = vmodel::mesh_boundary(model, mo);
+      if (trimmed) {
+        slice::TrimmedMeshOptions to;
+        to.mesh = mo;
+        mesh = slice::mesh_trimmed_boundary(model, to);
+      } else {
+        mesh = vmodel::mesh_boundary(model, mo);
+      }
     } catch (const Error& e) {
       throw e.within(opt->model);
     }
@@ -87,7 +97,9 @@ void add_mesh(CLI::App& app, Common& common) {
       throw Error(opt->model + ": the boundary mesh is not a closed manifold: " + std::to_string(edges.boundary_edges) +
                       " boundary edges, " + std::to_string(edges.non_manifold_edges) + " non-manifold edges, " +
                       std::to_string(edges.degenerate_triangles) +
-                      " degenerate triangles (cells that overlap, or meet along faces that do not coincide as a whole); "
+                      " degenerate triangles (" +
+                      (trimmed ? std::string("trimmed faces that do not meet within the weld distance, or ") : std::string()) +
+                      "cells that overlap, or meet along faces that do not coincide as a whole); "
                       "expected every edge shared by two triangles; --cells meshes each cell on its own; nothing written",
                   ErrorKind::failed);
     io::MeshWriteOptions wo;
@@ -101,6 +113,7 @@ void add_mesh(CLI::App& app, Common& common) {
                   {"format", io::mesh_format_name(format)},
                   {"units", model.units},
                   {"cells", opt->cells},
+                  {"trimmed", trimmed},
                   {"tolerance", mesh.tolerance},
                   {"max_deviation", mesh.max_deviation},
                   {"faces", mesh.faces},
@@ -121,8 +134,8 @@ void add_mesh(CLI::App& app, Common& common) {
                 colour && format != io::MeshFormat::stl ? "vertex colours" : "no colour");
     std::printf("faces %d, tolerance %s %s, largest deviation measured %s\n", mesh.faces, fmt(mesh.tolerance, 6).c_str(),
                 model.units.c_str(), fmt(mesh.max_deviation, 6).c_str());
-    std::printf("volume %s (cells by quadrature %s, difference %s), area %s\n", fmt(volume, 10).c_str(),
-                fmt(mesh.cell_volume, 10).c_str(), fmt(volume - mesh.cell_volume, 4).c_str(), fmt(area, 10).c_str());
+    std::printf("volume %s (cells %s %s, difference %s), area %s\n", fmt(volume, 10).c_str(),
+                trimmed ? "from their trimmed faces" : "by quadrature", fmt(mesh.cell_volume, 10).c_str(), fmt(volume - mesh.cell_volume, 4).c_str(), fmt(area, 10).c_str());
     std::printf("closed manifold: %d shell%s, Euler characteristic %lld\n", shells, shells == 1 ? "" : "s",
                 static_cast<long long>(euler));
   });

@@ -10,9 +10,11 @@
 #include <vector>
 
 #include "trivox/error.hpp"
+#include "trivox/geom/quadrature.hpp"
 #include "trivox/geom/trimmed_surface.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/slice/piece_measures.hpp"
+#include "trivox/slice/trim.hpp"
 #include "trivox/spline/extract.hpp"
 
 namespace trivox::slice {
@@ -666,7 +668,24 @@ vmodel::BoundaryMesh mesh_trimmed_boundary(const vmodel::VModel& model, const Tr
   if (!(tol > 0.0)) throw Error("mesh: the model has no extent (diagonal 0); expected cells with volume");
   const double eps = std::min(options.weld * diagonal, 0.5 * tol);
 
-  const ModelBoundary mb = model_boundary(model, options.boundary);
+  // A trimmed cell that its conditions admit whole (`trivox build` restricts a piece that is a
+  // parameter box of its trivariate to that box and keeps the conditions) is meshed as a plain
+  // cell: its faces then lie on its conditions' faces, which boundary_faces does not cut.
+  const double delta = 1e-6 * diagonal;
+  LocatorOptions lo;
+  lo.tolerance = 1e-3 * delta;
+  const Locator loc(model, lo);
+  vmodel::VModel work = model;
+  for (std::size_t c = 0; c < model.cells.size(); ++c) {
+    const auto& cell = model.cells[c];
+    if (cell.plain()) continue;
+    const double whole = std::abs(geom::volume(cell.volume));
+    if (std::abs(trimmed_volume(loc, static_cast<int>(c), 8) - whole) <= 1e-9 * whole) {
+      work.cells[c].within.clear();
+      work.cells[c].without.clear();
+    }
+  }
+  const ModelBoundary mb = model_boundary(work, options.boundary);
   auto cell_label = [&](int c) {
     return "cell \"" + model.cells[idx(c)].name + "\" (" + std::to_string(c) + ")";
   };
@@ -698,7 +717,7 @@ vmodel::BoundaryMesh mesh_trimmed_boundary(const vmodel::VModel& model, const Tr
         throw Error(cell_label(f.cell) + ": face " + std::string(spline::face_name(f.face)) + " of " + f.source_name +
                         " is glued to " + cell_label(f.glued_to) +
                         " over part of its area only (a face is not split where another cell covers it); expected faces "
-                        "glued whole or not at all; mesh each cell on its own instead (per cell)",
+                        "glued whole or not at all; mesh each cell on its own instead (per cell, --cells)",
                     ErrorKind::failed);
       groups.back().push_back(f);
     }
@@ -748,10 +767,6 @@ vmodel::BoundaryMesh mesh_trimmed_boundary(const vmodel::VModel& model, const Tr
         for (const int v : t)
           for (std::size_t d = 0; d < 3; ++d) normal[idx(v)][d] += n[d];
       }
-      const double delta = 1e-6 * diagonal;
-      LocatorOptions lo;
-      lo.tolerance = 1e-3 * delta;
-      const Locator loc(model, lo);
       std::vector<double> xyz(3), props(nprops);
       for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
         if (!needs[v]) continue;

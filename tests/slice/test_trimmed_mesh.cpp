@@ -9,8 +9,10 @@
 //   on the same faces (slice::piece_measures) and of the analytic volumes: boxes' products, and
 //   4 - A_c for the box minus the Coons cylinder (A_c by Green's theorem on its four arcs,
 //   boundary_fixtures.hpp);
-// - union of two boxes in a row with no common plane: one shell of genus 0 and volume
-//   2 + 8 - 1 = 9; per cell, the three pieces (A n B, A - B, B - A) are three shells;
+// - union of two boxes in a row with no common plane: one shell of genus 0, volume
+//   2 + 8 - 1 = 9 and area 28 (B's 24 less the unit square where A enters, plus A's five faces
+//   outside B), also after slice::untrim (as `trivox build` leaves it); per cell, the three
+//   pieces (A n B, A - B, B - A) are three shells;
 // - box union cylinder through it: one solid of genus 0, volume 4 + 2 A_c; per cell, the
 //   cylinder's part outside the box is one cell of two separate pieces: 4 shells, the box with
 //   the hole of genus 1 and three of genus 0, V - E + F = 0 + 3 x 2.
@@ -22,6 +24,7 @@
 
 #include "trivox/error.hpp"
 #include "trivox/slice/piece_measures.hpp"
+#include "trivox/slice/trim.hpp"
 #include "trivox/slice/trimmed_mesh.hpp"
 #include "trivox/vmodel/boolean.hpp"
 #include "boundary_fixtures.hpp"
@@ -148,6 +151,13 @@ TEST_CASE("meshes of unions", "[trimmed_mesh]") {
   check_solid(u, 1, 2, 9);
   CHECK(std::abs(u.volume - 9) <= 1e-12 * 9);
   CHECK(std::abs(u.area - 28) <= 1e-12 * 28);
+  // As `trivox build` leaves it: the pieces that are parameter boxes restricted to them, their
+  // conditions kept (whole faces on the conditions' faces): the same solid.
+  const auto r = mesh_of(slice::untrim(U), 1e-3);
+  print("two boxes united, restricted", r, 9);
+  check_solid(r, 1, 2, 9);
+  // (untrim finds the boxes' faces by bisection to 1e-13 of the domain.)
+  CHECK(std::abs(r.area - 28) <= 1e-9 * 28);
   const auto c = mesh_of(U, 1e-3, true);
   print("two boxes united, per cell", c, 9);
   check_solid(c, 3, 6, 9);
