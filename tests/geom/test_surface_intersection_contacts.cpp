@@ -2,6 +2,10 @@
 // (geom/surface_intersection.hpp). Truths:
 // - two planes whose line of intersection passes through a corner of the first patch only meet in
 //   that one point: no curve (a point bounds nothing), and no error;
+// - faces of two cells of construct's 7-cell ball that meet only along the edge they share (the
+//   cube's bottom and the x0 cap's inner face, x = z = -0.45) give curves on that edge only, each
+//   with at least 2 points (the marching there leaves both rectangles at once, and branches
+//   that shrank to one point made the curve fit throw before);
 // - a plane through the poles of a sphere of revolution (whose parametrisation is singular
 //   there) cuts it in a great circle: every curve returned lies on both surfaces, has at least 2
 //   points and its fitted curves, and the curves' total length is the circle's 2 pi up to the
@@ -16,7 +20,9 @@
 #include <cstdio>
 
 #include "trivox/construct/constructors.hpp"
+#include "trivox/construct/primitives.hpp"
 #include "trivox/geom/surface_intersection.hpp"
+#include "trivox/spline/extract.hpp"
 
 using namespace trivox;
 using spline::KnotVector;
@@ -57,9 +63,8 @@ TEST_CASE("planes meeting at one corner point give no curve", "[intersection][co
   CHECK(curves.empty());
   // The planes cross transversally: no tangential contact either.
   CHECK(contacts.empty());
-  // The same with the roles swapped, and with b shifted so that the line runs along a's edge y = 0
-  // for a moment only at the corner (1, 0): x + y = 1 through a's corners (1, 0) and (0, 1) is a
-  // diagonal, a proper curve.
+  // The same with the roles swapped; and the plane x + y = 1, through a's corners (1, 0) and
+  // (0, 1), cuts it along its diagonal: a proper curve.
   REQUIRE_NOTHROW(curves = geom::intersect_surfaces(b, a));
   CHECK(curves.empty());
   const Surface diag = plane_patch({0, 1, -1}, {2, -2, 0}, {0, 0, 2});
@@ -67,6 +72,32 @@ TEST_CASE("planes meeting at one corner point give no curve", "[intersection][co
   REQUIRE(curves.size() == 1);
   CHECK(curves[0].points.size() >= 2);
   CHECK(distance(curves[0].xyz.eval({0.0}), curves[0].points.front().xyz) < 1e-12);
+}
+
+TEST_CASE("faces of two ball cells meeting along an edge", "[intersection][contacts]") {
+  const auto cells = construct::build_primitive("S", construct::Sphere{{0, 0, 0}, 1});
+  auto cell = [&](const std::string& n) {
+    for (const auto& c : cells)
+      if (c.name == n) return c.volume;
+    FAIL("no cell " << n);
+    return cells[0].volume;
+  };
+  const Surface a = spline::boundary_face(cell("S.core"), spline::Face::w0);
+  const Surface b = spline::boundary_face(cell("S.x0"), spline::Face::w0);
+  std::vector<geom::IntersectionCurve> curves;
+  REQUIRE_NOTHROW(curves = geom::intersect_surfaces(a, b, {.tolerance = 1e-10}));
+  CHECK(!curves.empty());
+  for (const auto& c : curves) {
+    REQUIRE(c.points.size() >= 2);
+    CHECK(c.xyz.dim() == 3);
+    for (const auto& p : c.points) {
+      CHECK(distance(a.eval(p.uv1), p.xyz) < 1e-9);
+      CHECK(distance(b.eval(p.uv2), p.xyz) < 1e-9);
+      CHECK(std::abs(p.xyz[0] + 0.45) < 1e-9);
+      CHECK(std::abs(p.xyz[2] + 0.45) < 1e-9);
+      CHECK(std::abs(p.xyz[1]) <= 0.45 + 1e-9);
+    }
+  }
 }
 
 TEST_CASE("a plane through a sphere's poles", "[intersection][contacts]") {
