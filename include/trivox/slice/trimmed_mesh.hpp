@@ -24,15 +24,28 @@
 /// parametrises its own way (the two parameter-space images of one intersection curve), and
 /// patches of one face meet along the slab lines of the untrimming, whose sides need not end
 /// at the same points (T-junctions); so grids do not match by construction. Instead every
-/// sample on a patch's side is projected (Gauss-Newton on the side curve in space) onto every
-/// other patch's sides near it; where it lies within the weld distance of a side (default 1% of
-/// the chordal tolerance, as vmodel::mesh_boundary matches geometry), it is inserted into that
-/// side's samples unless a sample of it already lies that close. Two sides sharing a stretch of
-/// curve then carry the same points there, in the same order along the curve; the side's
-/// boundary cells of the grid are fanned from the cell's corner off the side, and all side
-/// samples within the weld distance of one another are welded into one vertex (single linkage
-/// over a hash grid). Triangles that welding makes degenerate (a side of zero length, where a
-/// triangle-like quad or a pole collapses) are dropped. Sides of zero length receive no points.
+/// sample on a patch's side is projected (Gauss-Newton on the side curve in space) onto the other
+/// patches' sides near it and inserted into each side it lies on, unless a sample of that side
+/// already is one with it; the grid cells along a side are fanned from the cell's corner off
+/// the side, and side samples that are one are welded into one vertex (single linkage over a
+/// hash grid). Two samples are one when
+/// - of two faces: within the weld distance in space (TrimmedMeshOptions::weld);
+/// - of one face: within 3/4 of its trimmed surface's tolerance in the face's parameters (its
+///   loops' gaps are at most half of it, geom::face_trim, and untrim merges events closer than
+///   it, so no slab is narrower; in space the narrowest slabs are far below the weld distance).
+/// And only where the sides share a curve: within a face, slab lines (sides 1 and 3, vertical in
+/// the face's parameters) with slab lines and curves with curves, other contacts being corners;
+/// another face's samples go only into sides on the face's loops (not every sample of which lies
+/// on another side of the face), and only the samples of such sides: a loop tangent to a slab line
+/// (where untrim cuts slabs at the vertical tangents of a hole) passes within the weld distance of
+/// the line's samples without meeting them. Triangles that welding makes degenerate (a side of no
+/// length, where a triangle-like quad or a pole collapses) are dropped; patches narrower than
+/// 1e-4 of the weld distance and sides shorter than that are nothing.
+///
+/// A trimmed cell whose conditions admit its whole trivariate (`trivox build` restricts a piece
+/// that is a parameter box to it and keeps the conditions, whose faces then lie on its own:
+/// boundary_faces does not cut coplanar faces) is meshed as a plain cell: slice::trimmed_volume
+/// (8^3 sub-boxes) within 1e-9 of its quadrature volume.
 ///
 /// Orientation. The patches keep their face's orientation of S_u x S_v (geom::untrim), and each
 /// face carries the piece's outward side (BoundaryFace::orientation); the triangles follow it,
@@ -49,7 +62,7 @@
 /// cell_volume is the sum of the pieces' exact volumes from the same faces (slice::piece_measures
 /// on them), which also checks that each piece's boundary closes (refused otherwise).
 ///
-/// Cost: model_boundary (surface intersections, trimming and untrimming of every cell), then per
+/// Cost: a trimmed_volume per trimmed cell, model_boundary (surface intersections, trimming and untrimming of every cell), then per
 /// patch (n_s + 1)(n_t + 1) evaluations per round plus the midpoints, one hash-grid query and a
 /// few Gauss-Newton steps per side sample near other sides, and one point location per vertex
 /// that needs the piece's properties. Deterministic (no threads; fixed orders).
