@@ -15,13 +15,17 @@
 //   pieces (A n B, A - B, B - A) are three shells;
 // - box union cylinder through it: one solid of genus 0, volume 4 + 2 A_c; per cell, the
 //   cylinder's part outside the box is one cell of two separate pieces: 4 shells, the box with
-//   the hole of genus 1 and three of genus 0, V - E + F = 0 + 3 x 2.
+//   the hole of genus 1 and three of genus 0, V - E + F = 0 + 3 x 2;
+// - a ball (construct's 7 bicubic cells) less a box through it: one solid of genus 0, its
+//   volume within 1e-3 of the pieces' exact one, which is the cap's pi h^2 (3r - h) / 3 within
+//   the primitive's distance from the true sphere.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <string>
 
+#include "trivox/construct/primitives.hpp"
 #include "trivox/error.hpp"
 #include "trivox/slice/piece_measures.hpp"
 #include "trivox/slice/trim.hpp"
@@ -187,4 +191,24 @@ TEST_CASE("trimmed meshes refuse bad options", "[trimmed_mesh]") {
   o.mesh.max_triangles = 10;
   CHECK_THROWS_AS(slice::mesh_trimmed_boundary(D, o), Error);
   CHECK_THROWS_AS(slice::mesh_trimmed_boundary(VModel{}), Error);
+}
+
+TEST_CASE("mesh of a ball cut by a box", "[trimmed_mesh]") {
+  // The unit ball of construct's 7 bicubic cells less the box x >= 0.3: one solid of genus 0.
+  // Its faces are cut along marched curves, and next to the cut disc's extreme points the
+  // untrimming leaves slabs narrower than the default weld distance.
+  VModel S, B;
+  for (auto& c : construct::build_primitive("S", construct::Sphere{{0, 0, 0}, 1})) S.cells.push_back({c.name, c.volume});
+  for (auto& c : construct::build_primitive("B", construct::Box{{0.3, -2, -2}, {2, 2, 2}})) B.cells.push_back({c.name, c.volume});
+  const VModel D = vmodel::boolean(S, B, BooleanOp::subtraction);
+  const auto f = mesh_of(D, 5e-4);
+  const double h = 1.3, cap = test::kPi * h * h * (3 - h) / 3;  // the exact ball's part x <= 0.3
+  print("ball minus box", f, cap);
+  CHECK(f.edges.manifold());
+  CHECK(f.shells == 1);
+  CHECK(f.euler == 2);
+  CHECK(std::abs(f.volume - f.mesh.cell_volume) <= 1e-3 * f.mesh.cell_volume);
+  CHECK(std::abs(f.volume - f.mesh.cell_volume) <= f.mesh.tolerance * f.area);
+  // The primitive's cells lie within about 1e-3 of the true sphere.
+  CHECK(std::abs(f.mesh.cell_volume - cap) <= 2e-3 * cap);
 }
