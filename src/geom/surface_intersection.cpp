@@ -154,34 +154,103 @@ bool overlap(const std::array<double, 6>& a, const std::array<double, 6>& b, dou
   return true;
 }
 
-/// Splits a Bezier patch in the parameter direction along which its control net is longer.
-std::pair<Surface, Surface> halve(const Surface& s) {
-  double len[2] = {0.0, 0.0};
+/// A Bezier patch as the seed search needs it: its control net in homogeneous xyz (w x, w y,
+/// w z, w; w = 1 when polynomial), point (i, j) at 4 (i + n0 j), its parameter box, and the box
+/// of its control points. Halving it is de Casteljau's step at the middle, one allocation per
+/// half, where a spline::split of a TensorSpline builds knot vectors and refinement matrices:
+/// the subdivision makes thousands of halves per pair of faces.
+struct Patch {
+  int n0 = 0, n1 = 0;
+  std::vector<double> net;
+  std::array<double, 4> dom{};  // u0, u1, v0, v1
+  std::array<double, 6> box{};
+
+  const double* at(int i, int j) const { return net.data() + 4 * (static_cast<std::size_t>(i) + static_cast<std::size_t>(n0) * static_cast<std::size_t>(j)); }
+  double* at(int i, int j) { return net.data() + 4 * (static_cast<std::size_t>(i) + static_cast<std::size_t>(n0) * static_cast<std::size_t>(j)); }
+
+  void bound() {
+    box = {1e300, 1e300, 1e300, -1e300, -1e300, -1e300};
+    for (std::size_t k = 0; k < net.size(); k += 4)
+      for (std::size_t d = 0; d < 3; ++d) {
+        const double x = net[k + d] / net[k + 3];
+        box[d] = std::min(box[d], x);
+        box[d + 3] = std::max(box[d + 3], x);
+      }
+  }
+};
+
+/// The patch of a Bezier piece (spline::bezier_pieces) of a surface.
+Patch to_patch(const Surface& s) {
+  Patch p;
   const auto n = s.counts();
+  p.n0 = n[0];
+  p.n1 = n[1];
+  p.net.resize(4 * static_cast<std::size_t>(n[0]) * static_cast<std::size_t>(n[1]));
   for (int j = 0; j < n[1]; ++j)
-    for (int i = 0; i + 1 < n[0]; ++i) {
-      const auto p = s.point(s.row({i, j})), q = s.point(s.row({i + 1, j}));
-      len[0] += std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
-    }
-  for (int j = 0; j + 1 < n[1]; ++j)
     for (int i = 0; i < n[0]; ++i) {
-      const auto p = s.point(s.row({i, j})), q = s.point(s.row({i, j + 1}));
-      len[1] += std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+      const int r = s.row({i, j});
+      const double w = s.rational() ? s.weights()[static_cast<std::size_t>(r)] : 1.0;
+      const auto x = s.point(r);
+      double* q = p.at(i, j);
+      q[0] = w * x[0];
+      q[1] = w * x[1];
+      q[2] = w * x[2];
+      q[3] = w;
     }
-  const int d = len[0] / n[1] >= len[1] / n[0] ? 0 : 1;
-  const auto dom = s.domain(d);
-  return spline::split(s, d, 0.5 * (dom[0] + dom[1]));
+  const auto du = s.domain(0), dv = s.domain(1);
+  p.dom = {du[0], du[1], dv[0], dv[1]};
+  p.bound();
+  return p;
 }
 
-void find_seeds(const Surface& p1, const Surface& p2, double small, double pad, const Solver& solver, int depth,
+/// Splits a Bezier patch at the middle of the parameter direction along which its control net
+/// is longer (de Casteljau at 1/2: exact, as the refinement of its knots would be).
+std::pair<Patch, Patch> halve(const Patch& s) {
+  double len[2] = {0.0, 0.0};
+  const auto pt = [&](int i, int j, std::size_t d) { return s.at(i, j)[d] / s.at(i, j)[3]; };
+  for (int j = 0; j < s.n1; ++j)
+    for (int i = 0; i + 1 < s.n0; ++i)
+      len[0] += std::hypot(pt(i, j, 0) - pt(i + 1, j, 0), pt(i, j, 1) - pt(i + 1, j, 1), pt(i, j, 2) - pt(i + 1, j, 2));
+  for (int j = 0; j + 1 < s.n1; ++j)
+    for (int i = 0; i < s.n0; ++i)
+      len[1] += std::hypot(pt(i, j, 0) - pt(i, j + 1, 0), pt(i, j, 1) - pt(i, j + 1, 1), pt(i, j, 2) - pt(i, j + 1, 2));
+  const int d = len[0] / s.n1 >= len[1] / s.n0 ? 0 : 1;
+  std::pair<Patch, Patch> out{s, s};
+  Patch& l = out.first;
+  Patch& r = out.second;
+  const int n = d == 0 ? s.n0 : s.n1, lines = d == 0 ? s.n1 : s.n0;
+  std::vector<double> tri(4 * static_cast<std::size_t>(n));
+  for (int line = 0; line < lines; ++line) {
+    const auto src = [&](int k) { return d == 0 ? s.at(k, line) : s.at(line, k); };
+    const auto dst = [&](Patch& p, int k) { return d == 0 ? p.at(k, line) : p.at(line, k); };
+    for (int k = 0; k < n; ++k) std::copy_n(src(k), 4, tri.data() + 4 * static_cast<std::size_t>(k));
+    // Level m of the triangle: the left half takes its first point, the right half its last.
+    for (int m = 0; m < n; ++m) {
+      std::copy_n(tri.data(), 4, dst(l, m));
+      std::copy_n(tri.data() + 4 * static_cast<std::size_t>(n - 1 - m), 4, dst(r, n - 1 - m));
+      for (int k = 0; k + 1 < n - m; ++k)
+        for (std::size_t c = 0; c < 4; ++c) {
+          const std::size_t a = 4 * static_cast<std::size_t>(k) + c;
+          tri[a] = 0.5 * (tri[a] + tri[a + 4]);
+        }
+    }
+  }
+  const double mid = 0.5 * (s.dom[2 * d] + s.dom[2 * d + 1]);
+  l.dom[2 * d + 1] = mid;
+  r.dom[2 * d] = mid;
+  l.bound();
+  r.bound();
+  return out;
+}
+
+void find_seeds(const Patch& p1, const Patch& p2, double small, double pad, const Solver& solver, int depth,
                 std::vector<IntersectionPoint>& seeds) {
-  const auto b1 = control_box(p1), b2 = control_box(p2);
-  if (!overlap(b1, b2, pad)) return;
-  const double d1 = diag(b1), d2 = diag(b2);
+  if (!overlap(p1.box, p2.box, pad)) return;
+  const double d1 = diag(p1.box), d2 = diag(p2.box);
   if ((d1 <= small && d2 <= small) || depth >= 24) {
     IntersectionPoint p;
-    p.uv1 = {0.5 * (p1.domain(0)[0] + p1.domain(0)[1]), 0.5 * (p1.domain(1)[0] + p1.domain(1)[1])};
-    p.uv2 = {0.5 * (p2.domain(0)[0] + p2.domain(0)[1]), 0.5 * (p2.domain(1)[0] + p2.domain(1)[1])};
+    p.uv1 = {0.5 * (p1.dom[0] + p1.dom[1]), 0.5 * (p1.dom[2] + p1.dom[3])};
+    p.uv2 = {0.5 * (p2.dom[0] + p2.dom[1]), 0.5 * (p2.dom[2] + p2.dom[3])};
     if (solver.solve(p, {})) seeds.push_back(p);
     return;
   }
@@ -488,7 +557,9 @@ std::vector<IntersectionCurve> intersect_surfaces(const Surface& a, const Surfac
   const double size = std::max(diag(control_box(a)), diag(control_box(b)));
   const double hmax = options.max_step * size;
   std::vector<IntersectionPoint> seeds;
-  const auto pa = spline::bezier_pieces(a), pb = spline::bezier_pieces(b);
+  std::vector<Patch> pa, pb;
+  for (const auto& p : spline::bezier_pieces(a)) pa.push_back(to_patch(p));
+  for (const auto& p : spline::bezier_pieces(b)) pb.push_back(to_patch(p));
   for (const auto& p1 : pa)
     for (const auto& p2 : pb) find_seeds(p1, p2, 0.5 * hmax, options.tolerance, solver, 0, seeds);
   std::vector<IntersectionCurve> out;
