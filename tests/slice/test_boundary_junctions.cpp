@@ -10,8 +10,8 @@
 //   by two of the cylinder's cells lie inside C and bound nothing;
 // - minus the same cylinder wholly inside it (z in [0.25, 0.75], a cavity): 16 + 2 A_c + 0.5 L_c,
 //   the lid and floor made of the five cells' end faces, and no shared face reported.
-// The 7-cell sphere and the 5-cell torus do not yet serve: some of their cells' faces meet at
-// single points, where geom::intersect_surfaces fails to fit a curve through one point.
+// The 7-cell ball and the 5-cell torus as conditions are measured in
+// test_boolean_curved_measures.cpp (inclusion-exclusion).
 // The holes are bounded by marched intersection curves, within their tolerance (1e-10) of the
 // exact sections, so areas agree to about 1e-9, checked to 1e-8 relative.
 #include <catch2/catch.hpp>
