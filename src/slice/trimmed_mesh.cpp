@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "../detail/union_find.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/geom/trimmed_surface.hpp"
@@ -51,22 +52,7 @@ double line_distance(const Vec3& p, const Vec3& a, const Vec3& b) noexcept {
   return norm(cross(sub(p, a), d)) / l;
 }
 
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int a) {
-    while (parent[idx(a)] != a) {
-      parent[idx(a)] = parent[idx(parent[idx(a)])];
-      a = parent[idx(a)];
-    }
-    return a;
-  }
-  void join(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[idx(std::max(a, b))] = std::min(a, b);
-  }
-};
+using detail::UnionFind;
 
 /// Integer cell of a uniform hash grid, packed into one key.
 struct GridKey {
@@ -171,35 +157,24 @@ std::array<double, 2> sample_patch(Patch& p, std::vector<double>& buf) {
     for (int i = 0; i <= p.ns; ++i)
       X.eval({static_cast<double>(i) / p.ns, static_cast<double>(j) / p.nt},
              p.grid.data() + (idx(j) * idx(p.ns + 1) + idx(i)) * idx(p.dim));
+  // The deviation of the segment a-b from the surface at its middle (s, t): from the side's curve
+  // on the patch's boundary, along the normal inside.
+  const auto deviation = [&](double s, double t, const Vec3& a, const Vec3& b, bool on_side) {
+    if (on_side) return line_distance(eval_xyz(X, s, t, buf), a, b);
+    const auto [m, n] = eval_normal(X, s, t, buf);
+    return normal_distance(m, {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}, n);
+  };
   double ds = 0.0, dt = 0.0;
   // Segments along s, rows j.
   for (int j = 0; j <= p.nt; ++j)
-    for (int i = 0; i < p.ns; ++i) {
-      const double s = (i + 0.5) / p.ns, t = static_cast<double>(j) / p.nt;
-      const Vec3 a = p.xyz(i, j), b = p.xyz(i + 1, j);
-      double dev = 0.0;
-      if (j == 0 || j == p.nt) {
-        dev = line_distance(eval_xyz(X, s, t, buf), a, b);
-      } else {
-        const auto [m, n] = eval_normal(X, s, t, buf);
-        dev = normal_distance(m, {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}, n);
-      }
-      ds = std::max(ds, dev);
-    }
+    for (int i = 0; i < p.ns; ++i)
+      ds = std::max(ds, deviation((i + 0.5) / p.ns, static_cast<double>(j) / p.nt, p.xyz(i, j), p.xyz(i + 1, j),
+                                  j == 0 || j == p.nt));
   // Segments along t, columns i.
   for (int i = 0; i <= p.ns; ++i)
-    for (int j = 0; j < p.nt; ++j) {
-      const double s = static_cast<double>(i) / p.ns, t = (j + 0.5) / p.nt;
-      const Vec3 a = p.xyz(i, j), b = p.xyz(i, j + 1);
-      double dev = 0.0;
-      if (i == 0 || i == p.ns) {
-        dev = line_distance(eval_xyz(X, s, t, buf), a, b);
-      } else {
-        const auto [m, n] = eval_normal(X, s, t, buf);
-        dev = normal_distance(m, {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}, n);
-      }
-      dt = std::max(dt, dev);
-    }
+    for (int j = 0; j < p.nt; ++j)
+      dt = std::max(dt, deviation(static_cast<double>(i) / p.ns, (j + 0.5) / p.nt, p.xyz(i, j), p.xyz(i, j + 1),
+                                  i == 0 || i == p.ns));
   // Quad centres against the triangulating diagonal (i, j) - (i + 1, j + 1).
   for (int j = 0; j < p.nt; ++j)
     for (int i = 0; i < p.ns; ++i) {

@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "../detail/union_find.hpp"
 #include "trivox/error.hpp"
 #include "trivox/geom/quadrature.hpp"
 #include "trivox/spline/extract.hpp"
@@ -43,22 +44,7 @@ double param_at(const Trivariate& s, int d, double x) noexcept {
   return dom[0] + (dom[1] - dom[0]) * x;
 }
 
-struct UnionFind {
-  std::vector<int> parent;
-  explicit UnionFind(int n) : parent(idx(n)) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int a) {
-    while (parent[idx(a)] != a) {
-      parent[idx(a)] = parent[idx(parent[idx(a)])];
-      a = parent[idx(a)];
-    }
-    return a;
-  }
-  void join(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[idx(std::max(a, b))] = std::min(a, b);
-  }
-};
+using detail::UnionFind;
 
 /// One face to tessellate.
 struct MeshFace {
@@ -388,7 +374,7 @@ BoundaryMesh mesh_boundary(const VModel& model, const MeshOptions& options) {
 
   // Classes of edges: node q < n_curves is V-curve q; n_curves + 2k (+1) is face k's s (t)
   // direction, joined with its edges t=0, t=1 (s=0, s=1).
-  UnionFind classes(n_curves + 2 * n_faces);
+  UnionFind classes(idx(n_curves + 2 * n_faces));
   for (int k = 0; k < n_faces; ++k) {
     const auto& half = topo.half_v_surfaces[idx(faces[idx(k)].half)];
     for (int e = 0; e < 4; ++e) {
