@@ -9,6 +9,7 @@
 
 #include "trivox/construct/constructors.hpp"
 #include "trivox/geom/surface_intersection.hpp"
+#include "intersection_fixtures.hpp"
 
 using namespace trivox;
 using spline::KnotVector;
@@ -16,23 +17,8 @@ using spline::Surface;
 
 namespace {
 
-Surface plane_patch(std::array<double, 3> o, std::array<double, 3> e1, std::array<double, 3> e2) {
-  std::vector<double> pts;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i)
-      for (std::size_t d = 0; d < 3; ++d) pts.push_back(o[d] + i * e1[d] + j * e2[d]);
-  return Surface({KnotVector::bezier(2), KnotVector::bezier(2)}, 3, pts);
-}
-
-Surface unit_sphere() {
-  // Half circle from the north to the south pole in the xz-plane, revolved about z.
-  const auto arc = construct::circle_arc(M_PI, 1e-11);
-  std::vector<double> pts;
-  for (int i = 0; i < arc.size(); ++i) pts.insert(pts.end(), {arc.point(i)[1], 0.0, arc.point(i)[0]});
-  construct::Revolution r;
-  r.relative_tolerance = 1e-11;
-  return construct::revolve(spline::Curve(arc.knot_vectors(), 3, pts), r);
-}
+using test::plane_patch;
+using test::unit_sphere;
 
 void check_on_both(const Surface& a, const Surface& b, const geom::IntersectionCurve& c, double tol) {
   for (const auto& p : c.points) {

@@ -22,6 +22,7 @@
 #include "trivox/construct/constructors.hpp"
 #include "trivox/construct/primitives.hpp"
 #include "trivox/geom/surface_intersection.hpp"
+#include "intersection_fixtures.hpp"
 #include "trivox/spline/extract.hpp"
 
 using namespace trivox;
@@ -30,22 +31,8 @@ using spline::Surface;
 
 namespace {
 
-Surface plane_patch(std::array<double, 3> o, std::array<double, 3> e1, std::array<double, 3> e2) {
-  std::vector<double> pts;
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i)
-      for (std::size_t d = 0; d < 3; ++d) pts.push_back(o[d] + i * e1[d] + j * e2[d]);
-  return Surface({KnotVector::bezier(2), KnotVector::bezier(2)}, 3, pts);
-}
-
-Surface unit_sphere() {
-  const auto arc = construct::circle_arc(M_PI, 1e-11);
-  std::vector<double> pts;
-  for (int i = 0; i < arc.size(); ++i) pts.insert(pts.end(), {arc.point(i)[1], 0.0, arc.point(i)[0]});
-  construct::Revolution r;
-  r.relative_tolerance = 1e-11;
-  return construct::revolve(spline::Curve(arc.knot_vectors(), 3, pts), r);
-}
+using test::plane_patch;
+using test::unit_sphere;
 
 double distance(const std::vector<double>& x, const std::array<double, 3>& y) {
   return std::hypot(x[0] - y[0], x[1] - y[1], x[2] - y[2]);
