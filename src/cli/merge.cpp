@@ -34,6 +34,8 @@ void add_merge(CLI::App& app, Common& common) {
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     static_cast<std::size_t>(opt->threads));
     const job::MergeSummary s = job::merge_job(opt->dir);
+    // A warning, not a failure: the archive is complete without the mesh.
+    if (!s.mesh_warning.empty()) std::fprintf(stderr, "trivox: warning: %s\n", s.mesh_warning.c_str());
     if (common.json) {
       nlohmann::ordered_json mats = nlohmann::ordered_json::object();
       for (std::size_t m = 0; m < s.materials.size(); ++m) mats[s.materials[m]] = s.material_voxels[m];
@@ -44,7 +46,8 @@ void add_merge(CLI::App& app, Common& common) {
                   {"layers", s.layers},
                   {"material_voxels", mats},
                   {"inversion_failures", s.inversion_failures},
-                  {"files", files}});
+                  {"files", files},
+                  {"mesh_warning", s.mesh_warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.mesh_warning)}});
       return;
     }
     std::printf("%s: merged %d shards, %d layers; every layer and part verified (SHA-256)\n", opt->dir.c_str(), s.shards,

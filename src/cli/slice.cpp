@@ -501,6 +501,12 @@ void add_slice(CLI::App& app, Common& common) {
                                 {"manifest", (std::filesystem::path(opt->out) / s.shard.manifest_name()).string()}};
     if (vdb_done) j["vdb_kept"] = vdb_done->file;
     if (!s.zip_file.empty()) j["zip"] = s.zip_file.string();
+    if (job.zip) {
+      j["mesh"] = s.mesh_file.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.mesh_file.string());
+      j["mesh_warning"] = s.mesh_warning.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(s.mesh_warning);
+    }
+    // A warning, not a failure: the archive is complete without the mesh.
+    if (!s.mesh_warning.empty()) std::fprintf(stderr, "trivox: warning: %s\n", s.mesh_warning.c_str());
     if (v) j["vdb"] = vdb_json(*v);
     if (common.json) return print_json(j);
     std::printf("sliced %s -> %s: %d x %d pixels x %d layers (%s, %g x %g dpi, %g mm layers)\n", opt->model.c_str(),
@@ -520,6 +526,7 @@ void add_slice(CLI::App& app, Common& common) {
                   s.shard.count, s.layer_range[0], s.layer_range[1] - 1, opt->out.c_str());
     if (s.layers_kept > 0) std::printf("resumed: %d layers kept (verified against the manifest)\n", s.layers_kept);
     if (vdb_done) std::printf("resumed: %s kept (verified against the manifest)\n", vdb_done->file.c_str());
+    if (!s.mesh_file.empty()) std::printf("mesh: %s\n", s.mesh_file.string().c_str());
     if (!s.zip_file.empty()) std::printf("packed: %s\n", s.zip_file.string().c_str());
     if (v) print_vdb(*v);
   });

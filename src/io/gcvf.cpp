@@ -13,6 +13,7 @@
 
 #include "png_rows.hpp"
 #include "trivox/error.hpp"
+#include "trivox/io/safe_path.hpp"
 #include "trivox/io/stack_config.hpp"
 
 namespace trivox::io {
@@ -117,7 +118,7 @@ fs::path gcvf_path(const fs::path& dir) {
   return zip;
 }
 
-void zip_stack(const fs::path& dir, const fs::path& gcvf) {
+void zip_stack(const fs::path& dir, const fs::path& gcvf, const std::vector<std::string>& extra) {
   const StackConfig c = read_stack_config(dir);
   const auto files = detail::list_slices(dir, c.prefix);
   std::vector<std::string> names;
@@ -128,6 +129,13 @@ void zip_stack(const fs::path& dir, const fs::path& gcvf) {
       throw Error((dir / c.slice_name(i)).string() + ": missing; expected all " + std::to_string(c.slices) +
                   " slices that ConfigFile.xml lists before packing a .gcvf");
     names.push_back(it->second);
+  }
+  for (const auto& name : extra) {
+    if (!plain_file_name(name))
+      throw Error(name + ": not a plain file name; expected a file of the folder " + dir.string() + " to pack");
+    std::error_code e;
+    if (!fs::is_regular_file(fs::symlink_status(dir / name, e)))
+      throw Error((dir / name).string() + ": missing or not a regular file; expected it beside the slices before packing a .gcvf");
   }
   std::error_code ec;
   if (fs::is_directory(gcvf, ec)) throw Error(gcvf.string() + ": is a folder; expected a .gcvf file path to write");
@@ -140,6 +148,7 @@ void zip_stack(const fs::path& dir, const fs::path& gcvf) {
   ZipWriter zip(gcvf, tmp);
   zip.add_file(dir / "ConfigFile.xml", "ConfigFile.xml", true, mtime);
   for (const auto& name : names) zip.add_file(dir / name, name, false, mtime);
+  for (const auto& name : extra) zip.add_file(dir / name, name, true, mtime);
   zip.close();
 }
 

@@ -11,6 +11,7 @@
 #include "../detail/json_text.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/gcvf.hpp"
+#include "trivox/job/archive_mesh.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/safe_path.hpp"
 #include "trivox/io/sha256.hpp"
@@ -351,8 +352,8 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
     if (!files[i].is_object()) r.fail_type(p, files[i], "an object {\"role\", \"file\", \"sha256\"}");
     ManifestFile f{r.string(r.member(files[i], p, "role"), p + "/role"), r.string(r.member(files[i], p, "file"), p + "/file"),
                    r.sha(r.member(files[i], p, "sha256"), p + "/sha256")};
-    if (f.role != "config" && f.role != "vdb" && f.role != "zip")
-      r.fail_type(p + "/role", files[i]["role"], "\"config\", \"vdb\" or \"zip\"");
+    if (f.role != "config" && f.role != "vdb" && f.role != "zip" && f.role != "mesh")
+      r.fail_type(p + "/role", files[i]["role"], "\"config\", \"vdb\", \"zip\" or \"mesh\"");
     for (const ManifestFile& g : m.files)
       if (g.role == f.role) r.fail_type(p + "/role", files[i]["role"], "each role once");
     // The names are turned into paths (resume, --force, merge): each must be the one trivox
@@ -366,6 +367,8 @@ Manifest parse_manifest(std::string_view text, const std::string& source) {
       r.fail_type(p + "/file", name, "a file name inside the folder");
     } else if (f.role == "config" && f.file != "ConfigFile.xml") {
       r.fail_type(p + "/file", name, "\"ConfigFile.xml\" for role config");
+    } else if (f.role == "mesh" && f.file != archive_mesh_name) {
+      r.fail_type(p + "/file", name, std::string("\"") + archive_mesh_name + "\" for role mesh");
     } else if (f.role == "vdb") {
       const std::string tail = (m.shard.count > 1 ? shard_suffix(m.shard) : std::string()) + ".vdb";
       if (f.file.size() <= tail.size() || !f.file.ends_with(tail))

@@ -8,6 +8,7 @@
 
 #include "trivox/error.hpp"
 #include "trivox/io/gcvf.hpp"
+#include "trivox/job/archive_mesh.hpp"
 #include "trivox/io/model_file.hpp"
 #include "trivox/io/safe_path.hpp"
 #include "trivox/io/sha256.hpp"
@@ -49,6 +50,9 @@ fs::path part_file(const fs::path& dir, const Manifest& job, const Shard& shard,
   } else if (f.role == "zip") {
     expected = zip_entry_name(dir);
     path = io::gcvf_path(dir);
+  } else if (f.role == "mesh") {
+    expected = archive_mesh_name;
+    path = dir / expected;
   } else {
     expected = "ConfigFile.xml";
     path = dir / expected;
@@ -173,6 +177,7 @@ MergeSummary merge_job(const fs::path& dir) {
   // The merged VDB's name and its parts' come from the job (the model's name), not from the
   // strings of the parts, which were checked above to be those names.
   std::vector<fs::path> vdb_parts;
+  std::optional<ManifestFile> mesh;  // the archive's boundary mesh (archive_mesh.hpp)
   const std::string vdb_name = vdb_file_name(job);
   for (const auto& [k, m] : parts) {
     for (const auto& l : m.layers) {
@@ -180,8 +185,10 @@ MergeSummary merge_job(const fs::path& dir) {
       for (std::size_t i = 0; i < l.voxels.size() && i < sum.material_voxels.size(); ++i) sum.material_voxels[i] += l.voxels[i];
       sum.inversion_failures += l.failures;
     }
-    for (const auto& f : m.files)
+    for (const auto& f : m.files) {
       if (f.role == "vdb") vdb_parts.push_back(dir / Shard{k, n}.part_name(vdb_name));
+      if (f.role == "mesh") mesh = f;  // shard 0's, verified above
+    }
   }
   if (!vdb_parts.empty() && static_cast<int>(vdb_parts.size()) != n)
     throw Error(dir.string() + ": only " + std::to_string(vdb_parts.size()) + " of " + std::to_string(n) +
@@ -194,8 +201,16 @@ MergeSummary merge_job(const fs::path& dir) {
     merged.files.push_back({"config", "ConfigFile.xml", io::sha256_hex(config)});
     const auto zip_opt = job.options.find("png.zip");
     if (zip_opt != job.options.end() && zip_opt->second == "yes") {
+      std::vector<std::string> extra;
+      if (mesh) {
+        merged.files.push_back(*mesh);
+        extra.push_back(mesh->file);
+      } else {
+        sum.mesh_warning = dir.string() + ": no " + std::string(archive_mesh_name) + " in the archive: shard 0 did not "
+                           "write one (the model could not be meshed; its output said why)";
+      }
       const fs::path zip = io::gcvf_path(dir);
-      io::zip_stack(dir, zip);
+      io::zip_stack(dir, zip, extra);
       merged.files.push_back({"zip", "../" + zip.filename().string(), io::sha256_file(zip)});
     }
   }

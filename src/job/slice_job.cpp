@@ -24,6 +24,7 @@
 #include "../io/png_codec.hpp"
 #include "../io/png_rows.hpp"
 #include "thread_time.hpp"
+#include "trivox/job/archive_mesh.hpp"
 #include "trivox/byte_size.hpp"
 #include "trivox/error.hpp"
 #include "trivox/io/model_file.hpp"
@@ -172,13 +173,14 @@ std::optional<long long> slice_number(const std::string& name) {
 
 /// Whether `name` is one of the outputs of job `id` (this shard's, for a shard): its slices, its
 /// manifest and journal, ConfigFile.xml and the VDB of a whole job, its own VDB part and write
-/// probe.
+/// probe, and the archive's Mesh.stl (a whole job's, shard 0's).
 bool job_output_name(const Manifest& id, const std::string& name) {
   const bool whole = id.shard.count == 1;
   if (const auto n = slice_number(name)) return whole || (*n >= id.layer_range[0] && *n < id.layer_range[1]);
   if (whole)
     return is_manifest_name(name) || is_journal_name(name) || name == "ConfigFile.xml" || name == vdb_file_name(id) ||
-           name.starts_with(".trivox-write-test");
+           name == archive_mesh_name || name.starts_with(".trivox-write-test");
+  if (id.shard.index == 0 && name == archive_mesh_name) return true;
   return name == id.shard.manifest_name() || name == id.shard.journal_name() || name == id.shard.part_name(vdb_file_name(id)) ||
          name == ".trivox-write-test-" + std::to_string(id.shard.index);
 }
@@ -224,7 +226,7 @@ void clear_earlier_job(const fs::path& dir, const Manifest& id, const std::vecto
   for (const auto& [name, m] : stale)
     for (const ManifestFile& f : m.files) {
       // The archive lives beside the folder, outside it: a job with --zip replaces it.
-      if (f.role != "vdb") continue;
+      if (f.role != "vdb" && f.role != "mesh") continue;
       // parse_manifest checked the name: a plain name inside the folder.
       const fs::path p = dir / f.file;
       const auto sha = io::sha256_regular_file(p);
@@ -642,7 +644,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
   }
   if (opt.dry_run) {
     est.voxels = static_cast<std::int64_t>(range_layers) * grid.voxels_per_layer();
-    est.files = range_layers + (opt.shard.count == 1 ? 2 : 1);
+    est.files = range_layers + (opt.shard.count == 1 ? 2 : 1) + (opt.zip && opt.shard.index == 0 ? 1 : 0);
     SliceJobSummary sum;
     sum.grid = grid;
     sum.dry_run = true;
@@ -747,7 +749,7 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
 
   est.layers = static_cast<int>(todo.size());
   est.voxels = static_cast<std::int64_t>(todo.size()) * grid.voxels_per_layer();
-  est.files = est.layers + (opt.shard.count == 1 ? 2 : 1);
+  est.files = est.layers + (opt.shard.count == 1 ? 2 : 1) + (opt.zip && opt.shard.index == 0 ? 1 : 0);
   int done = kept;
   std::vector<std::vector<int>> groups;
   {
@@ -821,18 +823,49 @@ SliceJobSummary run_slice_job(const vmodel::VModel& model, const SliceJobOptions
     sum.filled += totals[static_cast<std::size_t>(m)];
   }
   cfg = stack_config_of(manifest, totals);
+  // The archive's boundary mesh (archive_mesh.hpp): written by the whole job, or by shard 0 for
+  // merge to pack; kept when a resumed job's manifest lists it and its bytes verify. A model
+  // that cannot be meshed gives an archive without it and a warning.
+  std::vector<std::string> zip_extra;
+  std::optional<ManifestFile> mesh_entry;  // listed after ConfigFile.xml, as merge lists it
+  if (opt.zip && opt.shard.index == 0) {
+    const fs::path path = opt.out_dir / archive_mesh_name;
+    const ManifestFile* kept_mesh = nullptr;
+    if (previous)
+      for (const ManifestFile& f : previous->files)
+        if (f.role == "mesh" && f.file == archive_mesh_name && io::sha256_regular_file(path) == f.sha256) kept_mesh = &f;
+    if (kept_mesh) {
+      mesh_entry = *kept_mesh;
+      zip_extra.push_back(archive_mesh_name);
+      sum.mesh_file = path;
+    } else {
+      const ArchiveMesh mesh = archive_mesh(model, opt.model_name);
+      if (mesh.stl.empty()) {
+        sum.mesh_warning = opt.model_name + ": no " + archive_mesh_name + " in the archive: " + mesh.problem;
+      } else {
+        io::write_file_atomically(path, mesh.stl);
+        mesh_entry = ManifestFile{"mesh", archive_mesh_name, io::sha256_hex(mesh.stl)};
+        zip_extra.push_back(archive_mesh_name);
+        sum.mesh_file = path;
+        sum.mesh_triangles = mesh.triangles;
+      }
+    }
+  }
   if (opt.shard.count == 1) {
     // The configuration that makes the folder a complete stack, once every layer is on disk.
     io::sync_folder_contents(opt.out_dir);
     const std::string config = io::config_xml(cfg);
     io::write_file_atomically(opt.out_dir / "ConfigFile.xml", config);
     manifest.files.push_back({"config", "ConfigFile.xml", io::sha256_hex(config)});
+    if (mesh_entry) manifest.files.push_back(*mesh_entry);
     if (opt.zip) {
       const fs::path zip = io::gcvf_path(opt.out_dir);
-      io::zip_stack(opt.out_dir, zip);
+      io::zip_stack(opt.out_dir, zip, zip_extra);
       sum.zip_file = zip;
       manifest.files.push_back({"zip", "../" + zip.filename().string(), io::sha256_file(zip)});
     }
+  } else if (mesh_entry) {
+    manifest.files.push_back(*mesh_entry);
   }
   write_manifest(opt.last_output);
   end_journal();

@@ -153,7 +153,7 @@ ls "$sharded/manifest.shard-0-of-3.json" "$sharded/manifest.shard-1-of-3.json" "
 [ ! -e "$sharded/ConfigFile.xml" ]
 "$trivox" merge "$sharded" --json > "$tmp/merge.json"
 mkdir "$tmp/merged"
-cp "$sharded"/slice_*.png "$sharded/ConfigFile.xml" "$sharded/manifest.json" "$tmp/merged/"
+cp "$sharded"/slice_*.png "$sharded/ConfigFile.xml" "$sharded/Mesh.stl" "$sharded/manifest.json" "$tmp/merged/"
 same_folder "$tmp/whole" "$tmp/merged"
 cmp "$tmp/whole.gcvf" "$tmp/s/whole.gcvf"
 

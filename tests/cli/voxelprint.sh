@@ -6,6 +6,11 @@
 # inspect`'s, for unpadded and padded names, a zipped .gcvf, a transparent and a black void; the
 # same model gives the same pixels whatever the names; refusals exit 2 naming what was expected;
 # an earlier trivox's padded stack still resumes and merges to the same bytes.
+# The .gcvf's Mesh.stl, read by Python's zipfile and an STL parser written here: every edge in
+# exactly two facets, in opposite directions; its enclosed volume is the graded block's 9600 and a
+# plate less a cylinder's 4 - pi/4 within tolerance x area, and `trivox mesh`'s; the archive is
+# byte-identical for 1 and 2 threads and for 2 shards merged; a model that cannot be meshed gets
+# its archive without the mesh, a warning on stderr and in --json, exit 0.
 set -euo pipefail
 source tests/cli/lib.bash "$@"
 
@@ -104,7 +109,8 @@ assert names("u") == sorted(f"slice_{k}.png" for k in range(88)), names("u")[:5]
 assert names("p") == [f"slice_{k:05d}.png" for k in range(88)], names("p")[:5]
 import zipfile
 z = zipfile.ZipFile(os.path.join(t, "u.gcvf"))
-assert z.namelist() == ["ConfigFile.xml"] + [f"slice_{k}.png" for k in range(88)], z.namelist()[:4]
+# ConfigFile.xml, the slices, then the boundary mesh, as the public archives hold it.
+assert z.namelist() == ["ConfigFile.xml"] + [f"slice_{k}.png" for k in range(88)] + ["Mesh.stl"], z.namelist()[:4]
 PY
 for k in 0 7 42 87; do cmp "$tmp/u/slice_$k.png" "$tmp/p/slice_$(printf %05d $k).png"; done
 cmp "$tmp/u/ConfigFile.xml" "$tmp/p/ConfigFile.xml"    # the names are not in it
@@ -163,4 +169,100 @@ for f in "$tmp"/p/*; do cmp "$f" "$tmp/old/$(basename "$f")"; done
 "$trivox" slice $model -o "$tmp/sh" "${grid[@]}" --digits 5 --shard 1/2 > /dev/null
 "$trivox" merge "$tmp/sh" > /dev/null
 for f in "$tmp"/p/*; do cmp "$f" "$tmp/sh/$(basename "$f")"; done
+
+# 4. The archive's boundary mesh (docs/slice-output.md, "The .gcvf file").
+cat > "$tmp/post_scene.json" <<'EOF2'
+{ "trivox": 1, "units": "mm", "properties": ["r", "g", "b"],
+  "cells": [
+    { "name": "plate", "primitive": {"type": "box", "min": [-1, -1, 0], "max": [1, 1, 1]}, "field": {"constant": [0.3, 0.3, 0.3]} },
+    { "name": "post", "primitive": {"type": "cylinder", "base": [0, 0, -1], "axis": [0, 0, 1], "radius": 0.5, "height": 3}, "field": {"constant": [0.6, 0.6, 0.6]} }
+  ],
+  "operations": [ {"op": "subtraction", "a": "plate", "b": "post"} ] }
+EOF2
+"$trivox" build "$tmp/post_scene.json" -o "$tmp/post.json" > /dev/null
+fine=(--dpi 300,300 --layer 0.1 --progress never)
+"$trivox" slice "$tmp/post.json" -o "$tmp/post1" "${fine[@]}" --threads 1 --zip --json > "$tmp/post1.json"
+"$trivox" slice "$tmp/post.json" -o "$tmp/post2" "${fine[@]}" --threads 2 --zip > /dev/null
+cmp "$tmp/post1.gcvf" "$tmp/post2.gcvf"
+"$trivox" mesh "$tmp/post.json" -o "$tmp/post.stl" --json > "$tmp/post_mesh.json"
+"$trivox" mesh $model -o "$tmp/block.stl" --json > "$tmp/block_mesh.json"
+"$trivox" slice $model -o "$tmp/u1" --dpi 100,100 --layer 0.5 --progress never --threads 1 --zip > /dev/null
+cmp "$tmp/u.gcvf" "$tmp/u1.gcvf"
+"$trivox" slice $model -o "$tmp/zs" "${grid[@]}" --zip --shard 1/2 > /dev/null
+"$trivox" slice $model -o "$tmp/zs" "${grid[@]}" --zip --shard 0/2 > /dev/null
+"$trivox" merge "$tmp/zs" > /dev/null
+cmp "$tmp/u.gcvf" "$tmp/zs.gcvf"
+"$py" - "$tmp" <<'PY'
+import sys, os, json, math, struct, zipfile, hashlib
+from collections import Counter
+t = sys.argv[1]
+
+def read_stl(data):
+    """A binary STL: an 80-byte header, a little-endian uint32 count, 50 bytes a facet."""
+    assert len(data) >= 84 and not data.startswith(b"solid"), data[:80]
+    n, = struct.unpack_from("<I", data, 80)
+    assert len(data) == 84 + 50 * n, (len(data), n)
+    facets = []
+    for i in range(n):
+        f = struct.unpack_from("<12fH", data, 84 + 50 * i)
+        assert f[12] == 0
+        facets.append((f[3:6], f[6:9], f[9:12]))
+    return facets
+
+def check_closed(facets):
+    """Every edge in exactly two facets, once in each direction (vertices matched by their bits)."""
+    directed = Counter()
+    for a, b, c in facets:
+        assert len({a, b, c}) == 3, (a, b, c)
+        for p, q in ((a, b), (b, c), (c, a)):
+            directed[(p, q)] += 1
+    for (p, q), k in directed.items():
+        assert k == 1 and directed[(q, p)] == 1, (p, q, k)
+
+def volume(facets):
+    o = [sum(v[i] for f in facets for v in f) / (3 * len(facets)) for i in range(3)]
+    s = 0.0
+    for f in facets:
+        a, b, c = ([v[i] - o[i] for i in range(3)] for v in f)
+        s += (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0])) / 6
+    return s
+
+# The graded block: the box 40 x 20 x 10 and the arch (x = 40 u, y = 5 + 10 w, z = z(u) + 4 v:
+# det J = 40 x 10 x 4 over the unit cube), 8000 + 1600.
+for name, exact, mesh_json, stl in [("u", 9600.0, "block_mesh.json", "block.stl"), ("post1", 4 - math.pi / 4, "post_mesh.json", "post.stl")]:
+    z = zipfile.ZipFile(os.path.join(t, name + ".gcvf"))
+    assert z.namelist()[-1] == "Mesh.stl" and z.namelist()[0] == "ConfigFile.xml", z.namelist()[-2:]
+    assert b"Mesh" not in z.read("ConfigFile.xml")     # the format does not name it
+    data = z.read("Mesh.stl")
+    assert data == open(os.path.join(t, name, "Mesh.stl"), "rb").read()
+    assert data[80:] == open(os.path.join(t, stl), "rb").read()[80:]    # trivox mesh's triangles
+    facets = read_stl(data)
+    check_closed(facets)
+    v, m = volume(facets), json.load(open(os.path.join(t, mesh_json)))
+    assert abs(v - m["volume"]) <= 1e-5 * exact, (name, v, m["volume"])
+    # The triangles lie within the tolerance of the surface: the volume within tolerance x area.
+    assert abs(v - exact) <= m["tolerance"] * m["area"] + 1e-5 * exact, (name, v, exact, m["tolerance"])
+    # The manifest lists it with its SHA-256, as it lists the other outputs.
+    man = json.load(open(os.path.join(t, name, "manifest.json")))
+    files = {f["role"]: f for f in man["files"]}
+    assert files["mesh"] == {"role": "mesh", "file": "Mesh.stl", "sha256": hashlib.sha256(data).hexdigest()}, files
+s = json.load(open(os.path.join(t, "post1.json")))
+assert s["mesh"].endswith("post1/Mesh.stl") and s["mesh_warning"] is None, s
+PY
+
+# The quick start's wall stands on part of its plate's top, which the mesher refuses (docs/mesh.md):
+# the archive is written without a mesh, with a warning.
+"$trivox" build models/quickstart.json -o "$tmp/quick.json" > /dev/null
+"$trivox" slice "$tmp/quick.json" -o "$tmp/quick" "${grid[@]}" --zip --json > "$tmp/quick.out" 2> "$tmp/quick.err"
+grep -q "trivox: warning: .*no Mesh.stl in the archive: .*glued to cell .* over part of its area only" "$tmp/quick.err"
+"$py" - "$tmp" <<'PY'
+import sys, os, json, zipfile
+t = sys.argv[1]
+s = json.load(open(os.path.join(t, "quick.out")))
+assert s["mesh"] is None and "over part of its area only" in s["mesh_warning"], s
+names = zipfile.ZipFile(os.path.join(t, "quick.gcvf")).namelist()
+assert "Mesh.stl" not in names and names[0] == "ConfigFile.xml" and len(names) > 1, names
+assert not os.path.exists(os.path.join(t, "quick", "Mesh.stl"))
+assert "mesh" not in {f["role"] for f in json.load(open(os.path.join(t, "quick", "manifest.json")))["files"]}
+PY
 echo "voxelprint: ok"

@@ -245,7 +245,8 @@ TEST_CASE("names that become paths are the ones trivox writes, inside the folder
   check_message(refusal({{"zip", "x.gcvf", sha}}), {"/files/0/file", "\"../<folder>.gcvf\""});
   check_message(refusal({{"zip", "../../x.gcvf", sha}}), {"/files/0/file", "\"../<folder>.gcvf\""});
   check_message(refusal({{"zip", "/tmp/x.gcvf", sha}}), {"/files/0/file"});
-  check_message(refusal({{"model", "x.json", sha}}), {"/files/0/role", "expected \"config\", \"vdb\" or \"zip\""});
+  check_message(refusal({{"model", "x.json", sha}}), {"/files/0/role", "expected \"config\", \"vdb\", \"zip\" or \"mesh\""});
+  check_message(refusal({{"mesh", "model.stl", sha}}), {"/files/0/file", "\"Mesh.stl\" for role mesh"});
   check_message(refusal({{"vdb", "col.shard-1-of-3.vdb", sha}, {"vdb", "col.shard-1-of-3.vdb", sha}}),
                 {"/files/1/role", "each role once"});
   // What trivox writes reads back.

@@ -43,7 +43,7 @@ struct ManifestLayer {
 
 /// Another file of the job (VDB, ConfigFile.xml, the .gcvf zip).
 struct ManifestFile {
-  std::string role;    ///< "vdb", "config", "zip"
+  std::string role;    ///< "vdb", "config", "zip", "mesh" (the archive's Mesh.stl, in the folder)
   std::string file;    ///< name relative to the folder (the zip: relative to the folder's parent)
   std::string sha256;
 
@@ -126,7 +126,7 @@ std::string manifest_json(const Manifest& manifest);
 /// `slice_<k>.png` (zero-padded or not) for its index k; `files` roles are "config"
 /// (`ConfigFile.xml`), "vdb" (`<model>.vdb`, a shard's `<model>.shard-K-of-N.vdb` of its own K
 /// and N), "zip" (`../<folder>.gcvf`, whose folder name the reader compares with the folder it
-/// read), each at most once. A path with a separator, `..`, an absolute path or a NUL is refused.
+/// read), "mesh" (`Mesh.stl`, job/archive_mesh.hpp), each at most once. A path with a separator, `..`, an absolute path or a NUL is refused.
 /// @param source  the file name, for messages
 /// @throws Error (bad_input) "<source>: <JSON pointer>: ...; expected ..." for anything malformed,
 ///         e.g. "m.json: /files/0/file: found the string \"../x\"; expected a file name inside

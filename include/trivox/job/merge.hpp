@@ -7,7 +7,8 @@
 /// exactly once; every layer's PNG and every listed file exist with the SHA-256 the part records.
 /// Anything wrong is reported all at once, per shard, with the command that redoes it, so that
 /// only the failed shards are rerun. Then: ConfigFile.xml (voxel counts summed over the parts),
-/// the .gcvf when the job asked for one, the merged VDB when the parts have VDB parts, and
+/// the .gcvf when the job asked for one (with shard 0's Mesh.stl when it lists one,
+/// job/archive_mesh.hpp), the merged VDB when the parts have VDB parts, and
 /// manifest.json (complete, shard 0 of 1), each written atomically; the parts stay.
 ///
 /// Cost: one SHA-256 pass over every file (parallel), plus the VDB merge (io::merge_vdb_parts,
@@ -27,7 +28,9 @@ struct MergeSummary {
   std::vector<std::int64_t> material_voxels;  ///< per material, summed
   std::vector<std::string> materials;
   std::int64_t inversion_failures = 0;
-  std::vector<ManifestFile> files;     ///< what merge wrote (config, zip, vdb)
+  std::vector<ManifestFile> files;     ///< what merge wrote (config, mesh, zip, vdb)
+  /// Set when the job asked for a .gcvf and shard 0 lists no mesh: the archive has none.
+  std::string mesh_warning;
 };
 
 /// Merges the shards in `dir`.

@@ -44,7 +44,9 @@ struct SliceJobOptions {
   std::optional<std::filesystem::path> palette;  ///< palette file; the default palette when empty
   std::string dither = "fs";                   ///< fs, stochastic or none
   bool force = false;                          ///< write into a non-empty folder, exceed the limits
-  bool zip = false;                            ///< also pack the folder as <out_dir>.gcvf
+  /// Also pack the folder as <out_dir>.gcvf, with the model's boundary mesh as Mesh.stl
+  /// (job/archive_mesh.hpp; written into the folder by the whole job or shard 0).
+  bool zip = false;
   /// Zero padding of the slice numbers in file names: 0 (the default) names them as the public
   /// Voxel Print writers do, `slice_0.png`, `slice_1.png`; 5 gives `slice_00000.png`. 0..9.
   int digits = 0;
@@ -114,6 +116,13 @@ struct SliceJobSummary {
   double voxel_volume_mm3 = 0.0;
   std::string mapping;                   ///< how properties drive materials
   std::filesystem::path zip_file;        ///< set when zip was asked for
+  /// The archive's boundary mesh (job/archive_mesh.hpp), written with `zip` by a whole job and
+  /// shard 0 (empty when not, or when the model could not be meshed), its triangles (0 when
+  /// kept from a resumed run), and why there is none when meshing failed (a warning: the
+  /// archive is written without it).
+  std::filesystem::path mesh_file;
+  std::int64_t mesh_triangles = 0;
+  std::string mesh_warning;
   /// Thread-seconds (CPU time of the worker threads) spent per stage, summed over workers: sample (locate + evaluate), map
   /// (properties to fractions), dither, paint (material indices to RGBA and counts), encode (PNG
   /// and its SHA-256). Map, dither and paint run as one pass per row
