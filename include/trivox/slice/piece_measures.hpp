@@ -32,10 +32,11 @@
 /// exceeds the best corner by more than the tolerance): points of the boundary attain it, and
 /// the exact box is at most `bbox_tolerance` x diagonal larger on each side.
 ///
-/// Property integrals (mass per material, int_P rho dV) are not computed: a property is a
-/// polynomial of the trivariate's parameters, not of x, so no polynomial field with divergence
-/// rho exists to integrate over the boundary; it needs the parameter-space region of the piece
-/// (the untrimming of trimmed V-cells, Massarwi & Elber 2016, Sec. 7), which is not built.
+/// Property integrals (mass per material, int_P rho dV) are slice::property_integrals'
+/// (property_integrals.hpp): a property is a polynomial of the trivariate's parameters, not of x,
+/// so the faces must be taken to the parameter space first; that is polynomial, and the integral
+/// exact, for pieces of affine trivariates only (otherwise it needs the untrimming of trimmed
+/// V-cells, Massarwi & Elber 2016, Sec. 7, which is not built).
 ///
 /// Coplanar faces of the piece's trivariate and its direct conditions (planar control nets on one
 /// plane, overlapping) are refused before any intersection: boundary_faces does not cut them.
