@@ -227,18 +227,50 @@ BPoly compose(const spline::Surface& piece, const BPoly& u, const BPoly& v) {
   return std::move(rows[0]);
 }
 
-spline::Surface to_surface(const BPoly& b) {
-  return spline::Surface({spline::KnotVector::bezier(b.m + 1), spline::KnotVector::bezier(b.n + 1)}, b.k, b.c);
-}
-
 // ---------------------------------------------------------------------------------------------
 // The slab decomposition.
 
-/// A u-monotone piece of a trimming curve, oriented so that u increases with s.
-struct Mono {
+/// One Bezier piece of a monotone side, u increasing from u.front() to u.back().
+struct Seg {
   Poly u, v;
+  double len = 1.0;  ///< its share of the side's parameter (of the trimming curve's own)
+};
+
+/// A u-monotone piece of a trimming curve: the consecutive Bezier pieces of one trimming curve
+/// between two of its events (its ends, its vertical tangents, its crossings with knot lines of
+/// S in v), oriented so that u increases along it. It is one side of every quad it bounds, however
+/// many Bezier pieces (marched points) it has, so the slabs are cut at its events only.
+struct Mono {
+  std::vector<Seg> segs;
   int sign = 1;  ///< +1 when the loop runs towards +u here, -1 when it runs towards -u
   int loop = 0, piece = 0;
+  double u0() const { return segs.front().u.front(); }
+  double u1() const { return segs.back().u.back(); }
+  /// The first piece whose end reaches u = x.
+  std::size_t seg_at(double x) const {
+    std::size_t lo = 0, hi = segs.size() - 1;
+    while (lo < hi) {
+      const std::size_t m = (lo + hi) / 2;
+      if (segs[m].u.back() < x) lo = m + 1; else hi = m;
+    }
+    return lo;
+  }
+  double v_at(double x) const {
+    const Seg& g = segs[seg_at(x)];
+    return bern_eval(g.v, solve_increasing(g.u, x));
+  }
+  /// Whether every control point lies within tol of the line v = alpha + beta u through the
+  /// side's ends (a straight edge: the rectangle's sides, straight cuts).
+  bool straight(double tol, double& alpha, double& beta) const {
+    const double ua = u0(), ub = u1(), va = segs.front().v.front(), vb = segs.back().v.back();
+    if (!(ub > ua)) return false;
+    beta = (vb - va) / (ub - ua);
+    alpha = va - beta * ua;
+    for (const auto& g : segs)
+      for (std::size_t i = 0; i < g.u.size(); ++i)
+        if (!(std::abs(g.v[i] - (alpha + beta * g.u[i])) <= tol)) return false;
+    return true;
+  }
 };
 
 /// A boundary between regions inside a slab: a curve piece or a horizontal knot line.
@@ -248,13 +280,48 @@ struct Item {
   double v_mid = 0.0;  ///< v at the slab's middle, for ordering
   int order_key = 0;
   int sign() const { return mono ? mono->sign : 0; }
-  double v_at(double x) const {
-    return mono ? bern_eval(mono->v, solve_increasing(mono->u, x)) : h;
-  }
+  double v_at(double x) const { return mono ? mono->v_at(x) : h; }
   std::string name() const {
     return mono ? where(mono->loop, mono->piece) : "the knot line v = " + num(h);
   }
 };
+
+/// Bezier patches of one degree side by side in s, as one B-spline surface on [0, 1]^2: knots in
+/// s at the pieces' cumulative shares `lens`, each of multiplicity m (C0 joins), so the surface is
+/// exactly the pieces; the shared column of two neighbours is their mean (they agree to rounding).
+spline::Surface join_in_s(const std::vector<BPoly>& parts, const std::vector<double>& lens) {
+  const BPoly& f = parts.front();
+  if (parts.size() == 1)
+    return spline::Surface({spline::KnotVector::bezier(f.m + 1), spline::KnotVector::bezier(f.n + 1)}, f.k, f.c);
+  const int m = f.m, n = f.n, k = f.k;
+  double total = 0.0;
+  for (double l : lens) total += l;
+  // Any increasing knots give the same surface; the shares keep the parameter close to the
+  // curve's (even samples along it), with no piece shorter than 1e-9 of the whole.
+  std::vector<double> share(lens.size());
+  double sum = 0.0;
+  for (std::size_t i = 0; i < lens.size(); ++i) sum += share[i] = std::max(lens[i], 1e-9 * total);
+  std::vector<double> knots(static_cast<std::size_t>(m + 1), 0.0);
+  double acc = 0.0;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    acc += share[i];
+    for (int r = 0; r < m; ++r) knots.push_back(acc / sum);
+  }
+  for (int r = 0; r <= m; ++r) knots.push_back(1.0);
+  const int cs = static_cast<int>(parts.size()) * m + 1;
+  std::vector<double> pts(static_cast<std::size_t>(cs * (n + 1) * k), 0.0);
+  auto at = [&](int i, int j, int d) -> double& { return pts[static_cast<std::size_t>((j * cs + i) * k + d)]; };
+  for (std::size_t p = 0; p < parts.size(); ++p)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= m; ++i)
+        for (int d = 0; d < k; ++d) {
+          const int col = static_cast<int>(p) * m + i;
+          const double x = parts[p].at(i, j, d);
+          at(col, j, d) = (i == 0 && p > 0) ? 0.5 * (at(col, j, d) + x) : x;
+        }
+  return spline::Surface({spline::KnotVector(m + 1, std::move(knots)), spline::KnotVector::bezier(n + 1)}, k,
+                         std::move(pts));
+}
 
 struct Builder {
   const TrimmedSurface& ts;
@@ -277,13 +344,35 @@ struct Builder {
     return std::clamp(i, 0, static_cast<int>(br.size()) - 2);
   }
 
-  /// Emits the patch S(q) for the quad map q = (u, v) lying in the Bezier piece containing
-  /// (um, vm).
-  void emit(const BPoly& u, const BPoly& v, double um, double vm) {
+  /// Elevates a bivariate polynomial to degrees (qm, qn), direction by direction.
+  static BPoly elevate(const BPoly& src, int qm, int qn) {
+    BPoly e(qm, qn, src.k);
+    for (int c = 0; c < src.k; ++c) {
+      std::vector<Poly> cols;
+      for (int j = 0; j <= src.n; ++j) {
+        Poly row(static_cast<std::size_t>(src.m + 1));
+        for (int i = 0; i <= src.m; ++i) row[static_cast<std::size_t>(i)] = src.at(i, j, c);
+        cols.push_back(bern_elevate(row, qm));
+      }
+      for (int i = 0; i <= qm; ++i) {
+        Poly col(static_cast<std::size_t>(src.n + 1));
+        for (int j = 0; j <= src.n; ++j) col[static_cast<std::size_t>(j)] = cols[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)];
+        const Poly x = bern_elevate(col, qn);
+        for (int j = 0; j <= qn; ++j) e.at(i, j, c) = x[static_cast<std::size_t>(j)];
+      }
+    }
+    return e;
+  }
+
+  /// Emits the patch S(q) for the quad map q = (u, v), given piece by piece in s (one degree for
+  /// all, shares `lens` of the parameter), lying in the Bezier piece of S containing (um, vm).
+  void emit(const std::vector<BPoly>& us, const std::vector<BPoly>& vs, const std::vector<double>& lens, double um,
+            double vm) {
     const auto& s = ts.surface();
     const int iu = span_of(ubreaks, um), iv = span_of(vbreaks, vm);
     const auto& piece = pieces[static_cast<std::size_t>(iu + (static_cast<int>(ubreaks.size()) - 1) * iv)];
     const int p = s.orders()[0] - 1, q = s.orders()[1] - 1;
+    const BPoly &u = us.front(), &v = vs.front();
     const int ds = p * u.m + q * v.m, dt = p * u.n + q * v.n;
     if (ds + 1 > opt.limits.max_order || dt + 1 > opt.limits.max_order)
       throw Error("untrim: a patch of orders (" + std::to_string(ds + 1) + ", " + std::to_string(dt + 1) +
@@ -291,30 +380,23 @@ struct Builder {
                   ") composed with a quad map of degrees (" + std::to_string(std::max(u.m, v.m)) + ", " +
                   std::to_string(std::max(u.n, v.n)) + ")); expected orders of at most " +
                   std::to_string(opt.limits.max_order) + limit_hint("max_order"));
-    if (static_cast<std::int64_t>(out.patches.size()) >= opt.max_patches)
+    auto& r = out.report;
+    if (static_cast<std::int64_t>(out.patches.size()) >= opt.max_patches ||
+        r.spans + static_cast<std::int64_t>(us.size()) > opt.max_patches)
       throw Error("untrim: more than " + std::to_string(opt.max_patches) +
-                  " patches; expected at most that many (UntrimOptions::max_patches)");
-    const BPoly patch = compose(piece, u, v);
-    // The quad map as a 2-coordinate Bezier surface, both coordinates in one degree.
+                  " patches or Bezier pieces of patches; expected at most that many (UntrimOptions::max_patches)");
+    // The quad map as a 2-coordinate surface, both coordinates in one degree.
     const int qm = std::max(u.m, v.m), qn = std::max(u.n, v.n);
-    BPoly qd(qm, qn, 2);
-    for (int c = 0; c < 2; ++c) {
-      const BPoly& src = c == 0 ? u : v;
-      // Elevate src to (qm, qn) direction by direction through its rows and columns.
-      std::vector<Poly> cols;
-      for (int j = 0; j <= src.n; ++j) {
-        Poly row(static_cast<std::size_t>(src.m + 1));
-        for (int i = 0; i <= src.m; ++i) row[static_cast<std::size_t>(i)] = src.at(i, j, 0);
-        cols.push_back(bern_elevate(row, qm));
-      }
-      for (int i = 0; i <= qm; ++i) {
-        Poly col(static_cast<std::size_t>(src.n + 1));
-        for (int j = 0; j <= src.n; ++j) col[static_cast<std::size_t>(j)] = cols[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)];
-        const Poly e = bern_elevate(col, qn);
-        for (int j = 0; j <= qn; ++j) qd.at(i, j, c) = e[static_cast<std::size_t>(j)];
-      }
+    std::vector<BPoly> parts, maps;
+    for (std::size_t i = 0; i < us.size(); ++i) {
+      parts.push_back(compose(piece, us[i], vs[i]));
+      const BPoly eu = elevate(us[i], qm, qn), ev = elevate(vs[i], qm, qn);
+      BPoly qd(qm, qn, 2);
+      for (int j = 0; j <= qn; ++j)
+        for (int a = 0; a <= qm; ++a) qd.at(a, j, 0) = eu.at(a, j, 0), qd.at(a, j, 1) = ev.at(a, j, 0);
+      maps.push_back(std::move(qd));
     }
-    spline::Surface ps = to_surface(patch), qs = to_surface(qd);
+    spline::Surface ps = join_in_s(parts, lens), qs = join_in_s(maps, lens);
     // The composition checked against S at 5 x 5 points.
     double err = 0.0;
     std::vector<double> a(static_cast<std::size_t>(s.dim())), b(static_cast<std::size_t>(s.dim()));
@@ -327,10 +409,11 @@ struct Builder {
         ps.eval(st, b.data());
         for (std::size_t d = 0; d < a.size(); ++d) err = std::max(err, std::abs(a[d] - b[d]));
       }
-    auto& r = out.report;
     r.max_composition_error = std::max(r.max_composition_error, err);
     r.max_order_s = std::max(r.max_order_s, ds + 1);
     r.max_order_t = std::max(r.max_order_t, dt + 1);
+    r.spans += static_cast<std::int64_t>(us.size());
+    r.max_spans = std::max(r.max_spans, static_cast<int>(us.size()));
     out.patches.push_back(std::move(ps));
     out.domains.push_back(std::move(qs));
     r.patches = static_cast<std::int64_t>(out.patches.size());
@@ -352,18 +435,53 @@ struct Builder {
     return b;
   }
 
-  /// Ruled quad with vertical rulings: q = (U(s), (1 - t) vb(s) + t vt(s)).
-  void vertical_quad(const Poly& U, Poly vb, Poly vt, double um, double vm) {
-    // A horizontal curve (all coefficients equal) is a constant: the patch's degree does not
-    // grow with it.
-    for (Poly* c : {&vb, &vt})
-      if (std::all_of(c->begin(), c->end(), [&](double x) { return x == c->front(); })) c->resize(1);
-    // v in its own degree: between two knot lines it is constant in s and the patch is the
-    // Bezier piece itself, of the surface's degrees.
-    const int n = std::max(static_cast<int>(vb.size()), static_cast<int>(vt.size())) - 1;
-    vb = bern_elevate(std::move(vb), n);
-    vt = bern_elevate(std::move(vt), n);
-    emit(in_s(U), ruled(vb, vt), um, vm);
+  /// Ruled quad with vertical rulings over the pieces of the side `c`: per piece g,
+  /// q = (U_g(s), (1 - t) vb_g(s) + t vt_g(s)) with (vb_g, vt_g) = sides(index, g).
+  template <class Sides>
+  void vertical_quad(const Mono& c, Sides sides, double um, double vm) {
+    std::vector<Poly> vb, vt;
+    for (std::size_t i = 0; i < c.segs.size(); ++i) {
+      auto [b, t] = sides(i, c.segs[i]);
+      vb.push_back(std::move(b));
+      vt.push_back(std::move(t));
+    }
+    // A horizontal side (all coefficients equal) is a constant: the patch's degree does not grow
+    // with it. v in its own degree: between two knot lines it is constant in s and the patch is
+    // the Bezier piece itself, of the surface's degrees.
+    auto flat = [](const std::vector<Poly>& cs) {
+      return std::all_of(cs.begin(), cs.end(), [](const Poly& c) {
+        return std::all_of(c.begin(), c.end(), [&](double x) { return x == c.front(); });
+      });
+    };
+    for (auto* side : {&vb, &vt})
+      if (flat(*side))
+        for (Poly& c : *side) c.resize(1);
+    int n = 0;
+    for (std::size_t i = 0; i < vb.size(); ++i)
+      n = std::max({n, static_cast<int>(vb[i].size()) - 1, static_cast<int>(vt[i].size()) - 1});
+    std::vector<BPoly> us, vs;
+    std::vector<double> lens;
+    for (std::size_t i = 0; i < c.segs.size(); ++i) {
+      us.push_back(in_s(c.segs[i].u));
+      vs.push_back(ruled(bern_elevate(std::move(vb[i]), n), bern_elevate(std::move(vt[i]), n)));
+      lens.push_back(c.segs[i].len);
+    }
+    emit(us, vs, lens, um, vm);
+  }
+
+  /// The quad between side c and the line v = alpha + beta u (beta = 0: a knot line), c below
+  /// the line or above it.
+  void line_quad(const Mono& c, double alpha, double beta, bool c_below, double um, double vm) {
+    vertical_quad(c, [&](std::size_t, const Seg& g) {
+      Poly l;
+      if (beta == 0.0) {
+        l = {alpha};
+      } else {
+        l.resize(g.u.size());
+        for (std::size_t i = 0; i < g.u.size(); ++i) l[i] = alpha + beta * g.u[i];
+      }
+      return c_below ? std::make_pair(g.v, l) : std::make_pair(l, g.v);
+    }, um, vm);
   }
 
   static bool same_poly(Poly a, Poly b, double tol) {
@@ -379,40 +497,60 @@ struct Builder {
   void region(const Item& bot, const Item& top, double e0, double e1, double vm) {
     const double um = 0.5 * (e0 + e1);
     if (!bot.mono && !top.mono) {
-      vertical_quad({e0, e1}, {bot.h}, {top.h}, um, vm);
+      Mono m;
+      m.segs.push_back({{e0, e1}, {bot.h, bot.h}, 1.0});
+      line_quad(m, top.h, 0.0, true, um, vm);
     } else if (!bot.mono) {
-      vertical_quad(top.mono->u, {bot.h}, top.mono->v, um, vm);
+      line_quad(*top.mono, bot.h, 0.0, false, um, vm);
     } else if (!top.mono) {
-      vertical_quad(bot.mono->u, bot.mono->v, {top.h}, um, vm);
+      line_quad(*bot.mono, top.h, 0.0, true, um, vm);
     } else {
       two_curves(*bot.mono, *top.mono, e0, e1, vm, 0, bot, top);
     }
   }
 
-  /// The region between two curve pieces spanning [e0, e1] (restricted copies).
+  /// The region between two monotone sides spanning [e0, e1] (restricted copies).
   void two_curves(const Mono& b, const Mono& t, double e0, double e1, double vm, int depth,
                   const Item& bi, const Item& ti) {
     const double um = 0.5 * (e0 + e1);
-    if (same_poly(b.u, t.u, tol)) {
-      vertical_quad(b.u, b.v, t.v, um, vm);
+    const double side = 0.01 * tol;
+    // Both with the same u-polynomials piece by piece (straight edges with one parameter, say).
+    bool same = b.segs.size() == t.segs.size();
+    for (std::size_t i = 0; same && i < b.segs.size(); ++i) same = same_poly(b.segs[i].u, t.segs[i].u, tol);
+    if (same) {
+      vertical_quad(b, [&](std::size_t i, const Seg& g) { return std::make_pair(g.v, t.segs[i].v); }, um, vm);
+      return;
+    }
+    // A straight side (to rounding: it replaces the curve) is a function of u: the other side's
+    // u parametrises it.
+    double alpha = 0.0, beta = 0.0;
+    const auto du = ts.surface().domain(0), dv = ts.surface().domain(1);
+    const double flat = std::min(side, 1e-13 * std::max(du[1] - du[0], dv[1] - dv[0]));
+    if (t.straight(flat, alpha, beta)) {
+      line_quad(b, alpha, beta, true, um, vm);
+      return;
+    }
+    if (b.straight(flat, alpha, beta)) {
+      line_quad(t, alpha, beta, false, um, vm);
       return;
     }
     // Separator v = alpha + beta u through the midpoints of the left and right sides.
-    const double l = 0.5 * (b.v.front() + t.v.front()), r = 0.5 * (b.v.back() + t.v.back());
-    const double beta = (r - l) / (e1 - e0), alpha = l - beta * e0;
-    Poly lb(b.u.size()), lt(t.u.size()), db(b.u.size()), dt(t.u.size());
-    for (std::size_t i = 0; i < b.u.size(); ++i) {
-      lb[i] = alpha + beta * b.u[i];
-      db[i] = b.v[i] - lb[i];
-    }
-    for (std::size_t i = 0; i < t.u.size(); ++i) {
-      lt[i] = alpha + beta * t.u[i];
-      dt[i] = lt[i] - t.v[i];
-    }
-    const double side = 0.01 * tol;
-    if (bern_at_most(db, side) && bern_at_most(dt, side)) {
-      vertical_quad(b.u, b.v, lb, um, vm);
-      vertical_quad(t.u, lt, t.v, um, vm);
+    const double l = 0.5 * (b.segs.front().v.front() + t.segs.front().v.front());
+    const double r = 0.5 * (b.segs.back().v.back() + t.segs.back().v.back());
+    beta = (r - l) / (e1 - e0);
+    alpha = l - beta * e0;
+    bool between = true;
+    for (const auto* c : {&b, &t})
+      for (std::size_t k = 0; between && k < c->segs.size(); ++k) {
+        const Seg& g = c->segs[k];
+        Poly d(g.u.size());
+        for (std::size_t i = 0; i < g.u.size(); ++i)
+          d[i] = (c == &b ? 1.0 : -1.0) * (g.v[i] - (alpha + beta * g.u[i]));
+        between = bern_at_most(d, side);
+      }
+    if (between) {
+      line_quad(b, alpha, beta, true, um, vm);
+      line_quad(t, alpha, beta, false, um, vm);
       return;
     }
     if (depth >= opt.max_splits)
@@ -423,19 +561,36 @@ struct Builder {
     const double mid = 0.5 * (e0 + e1);
     const auto [bl, br] = split_at(b, mid);
     const auto [tl, tr] = split_at(t, mid);
-    const double vml = 0.5 * (bern_eval(bl.v, 0.5) + bern_eval(tl.v, 0.5));
-    const double vmr = 0.5 * (bern_eval(br.v, 0.5) + bern_eval(tr.v, 0.5));
+    const double vml = 0.5 * (bl.v_at(0.5 * (e0 + mid)) + tl.v_at(0.5 * (e0 + mid)));
+    const double vmr = 0.5 * (br.v_at(0.5 * (mid + e1)) + tr.v_at(0.5 * (mid + e1)));
     two_curves(bl, tl, e0, mid, vml, depth + 1, bi, ti);
     two_curves(br, tr, mid, e1, vmr, depth + 1, bi, ti);
   }
 
+  /// The side m cut at u = x (inside its range): the parts before and after. A cut within 1e-12
+  /// of the parameter of a piece's end is made there, so no piece of no length is left.
   static std::pair<Mono, Mono> split_at(const Mono& m, double x) {
-    const double s = solve_increasing(m.u, x);
+    const std::size_t k = m.seg_at(x);
+    const Seg& g = m.segs[k];
+    const double s = solve_increasing(g.u, x);
     Mono a = m, b = m;
-    std::tie(a.u, b.u) = bern_split(m.u, s);
-    std::tie(a.v, b.v) = bern_split(m.v, s);
-    a.u.back() = x;
-    b.u.front() = x;
+    a.segs.assign(m.segs.begin(), m.segs.begin() + static_cast<std::ptrdiff_t>(k));
+    b.segs.assign(m.segs.begin() + static_cast<std::ptrdiff_t>(k) + 1, m.segs.end());
+    if (s <= 1e-12 && k > 0) {
+      b.segs.insert(b.segs.begin(), g);
+    } else if (s >= 1.0 - 1e-12 && k + 1 < m.segs.size()) {
+      a.segs.push_back(g);
+    } else {
+      Seg l = g, r = g;
+      std::tie(l.u, r.u) = bern_split(g.u, s);
+      std::tie(l.v, r.v) = bern_split(g.v, s);
+      l.len = g.len * s;
+      r.len = g.len * (1.0 - s);
+      a.segs.push_back(std::move(l));
+      b.segs.insert(b.segs.begin(), std::move(r));
+    }
+    a.segs.back().u.back() = x;
+    b.segs.front().u.front() = x;
     return {a, b};
   }
 
@@ -451,16 +606,38 @@ struct Builder {
       loops.push_back({{line(du[0], dv[0], du[1], dv[0]), line(du[1], dv[0], du[1], dv[1]),
                         line(du[1], dv[1], du[0], dv[1]), line(du[0], dv[1], du[0], dv[0])}});
     }
-    // 1. u-monotone pieces within one knot span of S in v.
+    // 1. u-monotone sides: each trimming curve's Bezier pieces cut at the roots of u' and at
+    // the crossings with interior knot lines, consecutive parts joined into one side until an
+    // event (a cut, a change of direction, a vertical part, a knot line in v reached at a piece's
+    // end, the curve's end).
     std::vector<Mono> monos;
+    std::int64_t segs = 0;
     for (std::size_t li = 0; li < loops.size(); ++li)
-      for (std::size_t pi = 0; pi < loops[li].pieces.size(); ++pi)
+      for (std::size_t pi = 0; pi < loops[li].pieces.size(); ++pi) {
+        Mono cur;
+        auto flush = [&] {
+          if (!cur.segs.empty()) {
+            if (cur.sign < 0) {
+              std::reverse(cur.segs.begin(), cur.segs.end());
+              for (auto& g : cur.segs) {
+                std::reverse(g.u.begin(), g.u.end());
+                std::reverse(g.v.begin(), g.v.end());
+              }
+            }
+            monos.push_back(std::move(cur));
+          }
+          cur = Mono{};
+        };
         for (const auto& bz : spline::bezier_pieces(loops[li].pieces[pi])) {
           Poly u(static_cast<std::size_t>(bz.size())), v(u.size());
           for (int i = 0; i < bz.size(); ++i) {
             u[static_cast<std::size_t>(i)] = bz.point(i)[0];
             v[static_cast<std::size_t>(i)] = bz.point(i)[1];
           }
+          const double span = bz.domain(0)[1] - bz.domain(0)[0];
+          // A piece starting on an interior knot line in v ends the side before it.
+          const auto on_v = std::upper_bound(vbreaks.begin() + 1, vbreaks.end() - 1, v.front() - tol);
+          if (on_v != vbreaks.end() - 1 && *on_v <= v.front() + tol) flush();
           std::vector<double> cuts;
           bern_roots(bern_derivative(u), 0.0, 1.0, 1e-3 * tol, 0, cuts);
           // Crossings with the interior knot lines within the piece's control box only, so the
@@ -493,30 +670,33 @@ struct Builder {
               pu = ru;
               pv = rv;
             }
-            if (std::abs(pu.back() - pu.front()) <= tol) continue;  // vertical: no area
-            Mono m;
-            m.loop = static_cast<int>(li);
-            m.piece = static_cast<int>(pi);
-            if (pu.back() < pu.front()) {
-              std::reverse(pu.begin(), pu.end());
-              std::reverse(pv.begin(), pv.end());
-              m.sign = -1;
+            if (i > 1) flush();  // a cut inside the piece: an event
+            if (std::abs(pu.back() - pu.front()) <= tol) {  // vertical: no area
+              flush();
+              continue;
             }
-            m.u = std::move(pu);
-            m.v = std::move(pv);
-            monos.push_back(std::move(m));
-            if (static_cast<std::int64_t>(monos.size()) > opt.max_patches)
+            const int sign = pu.back() > pu.front() ? 1 : -1;
+            if (!cur.segs.empty() && sign != cur.sign) flush();
+            if (cur.segs.empty()) {
+              cur.sign = sign;
+              cur.loop = static_cast<int>(li);
+              cur.piece = static_cast<int>(pi);
+            }
+            cur.segs.push_back({std::move(pu), std::move(pv), span * (at[i] - at[i - 1])});
+            if (++segs > opt.max_patches)
               throw Error("untrim: more than " + std::to_string(opt.max_patches) +
                           " monotone curve pieces; expected at most that many (UntrimOptions::max_patches)");
           }
         }
-    // 2. Events: knot lines of S in u (domain ends included) and the pieces' ends, merged
+        flush();
+      }
+    // 2. Events: knot lines of S in u (domain ends included) and the sides' ends, merged
     // within the tolerance (a knot value wins over a curve end).
     std::vector<std::pair<double, int>> ev;
     for (double b : ubreaks) ev.push_back({b, 0});
     for (const auto& m : monos) {
-      ev.push_back({m.u.front(), 1});
-      ev.push_back({m.u.back(), 1});
+      ev.push_back({m.u0(), 1});
+      ev.push_back({m.u1(), 1});
     }
     std::sort(ev.begin(), ev.end());
     std::vector<double> events;
@@ -531,24 +711,27 @@ struct Builder {
       events.push_back(rep);
       i = j + 1;
     }
-    // 3. Every piece cut at the events it spans, each part filed under its slab.
+    // 3. Every side cut at the events it spans, each part filed under its slab.
     const std::size_t slabs = events.size() - 1;
     std::vector<std::vector<Mono>> in_slab(slabs);
     std::int64_t parts = 0;
+    auto file = [&](Mono&& m) {
+      const std::size_t k = static_cast<std::size_t>(span_of(events, 0.5 * (m.u0() + m.u1())));
+      parts += static_cast<std::int64_t>(m.segs.size());
+      if (parts > opt.max_patches)
+        throw Error("untrim: more than " + std::to_string(opt.max_patches) +
+                    " curve pieces in slabs; expected at most that many (UntrimOptions::max_patches)");
+      in_slab[k].push_back(std::move(m));
+    };
     for (const auto& m : monos) {
       Mono rest = m;
-      auto it = std::upper_bound(events.begin(), events.end(), m.u.front() + tol);
-      for (; it != events.end() && *it < m.u.back() - tol; ++it) {
+      auto it = std::upper_bound(events.begin(), events.end(), m.u0() + tol);
+      for (; it != events.end() && *it < m.u1() - tol; ++it) {
         auto [a, b] = split_at(rest, *it);
-        const std::size_t k = static_cast<std::size_t>(span_of(events, 0.5 * (a.u.front() + a.u.back())));
-        in_slab[k].push_back(std::move(a));
+        file(std::move(a));
         rest = std::move(b);
-        if (++parts > opt.max_patches)
-          throw Error("untrim: more than " + std::to_string(opt.max_patches) +
-                      " curve pieces in slabs; expected at most that many (UntrimOptions::max_patches)");
       }
-      const std::size_t k = static_cast<std::size_t>(span_of(events, 0.5 * (rest.u.front() + rest.u.back())));
-      in_slab[k].push_back(std::move(rest));
+      file(std::move(rest));
     }
     // 4. Per slab: items ordered bottom to top, winding numbers, quads where it is 1.
     std::int64_t work = 0;
@@ -557,11 +740,12 @@ struct Builder {
       // Knot lines between the lowest and highest curve point of the slab: below and above
       // them the winding number is 0.
       double vlo = 1e300, vhi = -1e300;
-      for (const auto& m : in_slab[k]) {
-        const auto [lo, hi] = std::minmax_element(m.v.begin(), m.v.end());
-        vlo = std::min(vlo, *lo);
-        vhi = std::max(vhi, *hi);
-      }
+      for (const auto& m : in_slab[k])
+        for (const auto& g : m.segs) {
+          const auto [lo, hi] = std::minmax_element(g.v.begin(), g.v.end());
+          vlo = std::min(vlo, *lo);
+          vhi = std::max(vhi, *hi);
+        }
       std::vector<Item> items;
       for (auto bi = std::lower_bound(vbreaks.begin(), vbreaks.end(), vlo - tol);
            bi != vbreaks.end() && *bi <= vhi + tol; ++bi) {

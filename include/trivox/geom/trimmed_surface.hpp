@@ -13,23 +13,26 @@
 /// blended Coons patch, Cohen et al. 2001); (3) compose S with each quad map, q(s, t) ->
 /// S(q(s, t)), giving tensor-product Bezier patches that tile S restricted to D.
 ///
-/// The tiling is a slab (trapezoidal) decomposition. Every trimming curve is cut into Bezier
-/// pieces, then at its vertical tangents (roots of u'), at its crossings with the knot lines of
-/// S in u and in v, and at the vertical lines through every cut point and every knot line of S
-/// in u (the events). Between two consecutive events every curve piece spans the whole slab and
-/// is u-monotone, and pieces and horizontal knot lines of S (domain edges included) do not
-/// cross inside it, so they are ordered from bottom to top; a region between two neighbours
-/// whose winding number is 1 is a quad of D whose left and right sides are vertical segments,
-/// possibly of zero length (a triangle-like quad where the loop turns or has a corner).
+/// The tiling is a slab (trapezoidal) decomposition whose sides are the monotone pieces of the
+/// trimming curves (quads with freeform sides, Massarwi & Elber 2016, Sec. 5.1). Every trimming
+/// curve is cut at its vertical tangents (roots of u'), at its crossings with the knot lines of
+/// S in v and at its ends; the consecutive Bezier pieces between two such cuts (a marched
+/// intersection curve has one per marched point) form one u-monotone side. The events are the
+/// sides' ends and the knot lines of S in u: the slabs are cut at those vertical lines only, not
+/// at every Bezier piece's end, so no slab is narrower than the distance between two real events
+/// of the loops. Between two consecutive events every side spans the whole slab, and sides and
+/// horizontal knot lines of S (domain edges included) do not cross inside it, so they are ordered
+/// from bottom to top; a region between two neighbours whose winding number is 1 is a quad of D
+/// whose left and right sides are vertical segments, possibly of zero length (a triangle-like
+/// quad where the loop turns or has a corner).
 ///
 /// Quad maps keep each curve's own (polynomial) parameter; no curve is refitted. With straight
 /// sides the Boolean sum is the ruled map (1 - t) c_bottom(s) + t c_top(s). It is used with
 /// vertical rulings only, which stay inside the slab region and never cross: q(s, t) =
 /// (U(s), (1 - t) v_bottom(s) + t v_top(s)), where U is the bottom and top sides' common
-/// u-polynomial. That holds when a side is a knot line (a horizontal line, parametrised by the
-/// other side's u(s)) or when both curves have the same u-polynomial (straight edges, for
-/// example). Otherwise the quad is split by a straight separator v = alpha + beta u through
-/// the midpoints of its left and right sides, checked to lie between the two curves (signs of
+/// u-polynomial. That holds when a side is a knot line or a straight edge (a line, parametrised
+/// by the other side's u(s)) or when both curves have the same u-polynomials. Otherwise the
+/// quad is split by a straight separator v = alpha + beta u through the midpoints of its left and right sides, checked to lie between the two curves (signs of
 /// Bernstein coefficients, subdivided where needed); each half is then a ruled map between a
 /// curve and the separator parametrised by that curve's u(s). Where no such separator exists
 /// the slab is halved (up to `UntrimOptions::max_splits` times). Every quad map is polynomial
@@ -40,7 +43,9 @@
 /// [0, 1]^2 and S's de Casteljau algorithm is run on bivariate Bernstein polynomials (products
 /// of Bernstein forms), so the patch of a surface of degrees (p, q) over a quad map whose u has
 /// degrees (a_s, a_t) and v (b_s, b_t) has degrees (p a_s + q b_s, p a_t + q b_t): for a
-/// bicubic surface and cubic curves, (18, 3).
+/// bicubic surface and cubic curves, (18, 3). A side of several Bezier pieces gives one patch of
+/// as many knot spans in s (each the exact composition over its piece, joined with knots of
+/// multiplicity equal to the degree), its knots at the pieces' shares of the curve's parameter.
 ///
 /// Cost: O(E x I log I) for E events and I curve pieces and knot lines per slab, plus per patch
 /// the composition, O(p q (deg_s deg_t) k) for k coordinates. Counts and orders are capped
@@ -96,7 +101,8 @@ private:
 };
 
 struct UntrimOptions {
-  /// Refuse (trivox::Error, bad_input) before building more patches than this.
+  /// Refuse (trivox::Error, bad_input) before building more patches, or Bezier pieces (knot
+  /// spans in s) of patches in all, than this.
   std::int64_t max_patches = 100'000;
   /// How often a slab may be halved to fit a separator between two curves; beyond it untrim
   /// fails (trivox::Error, failed: the curves touch or nearly so).
@@ -114,13 +120,17 @@ struct UntrimReport {
   /// inputs are polynomial and no curve is refitted.
   bool exact = true;
   int max_order_s = 0, max_order_t = 0;  ///< largest patch orders
+  /// Bezier pieces (knot spans in s) over all patches, and the most in one patch.
+  std::int64_t spans = 0;
+  int max_spans = 0;
 };
 
 /// The untrimmed patches: patches[i] = S(domains[i](s, t)) on [0, 1]^2.
 struct Untrimmed {
-  /// Bezier patches on [0, 1]^2 with the surface's coordinates.
+  /// Patches on [0, 1]^2 with the surface's coordinates: Bezier in t; in s one Bezier piece per
+  /// piece of the quad's curved side (C0 knots), a Bezier patch where that side has one piece.
   std::vector<spline::Surface> patches;
-  /// The quad maps q_i: [0, 1]^2 -> parameter plane (2 coordinates, Bezier on [0, 1]^2),
+  /// The quad maps q_i: [0, 1]^2 -> parameter plane (2 coordinates, with the patch's knots in s),
   /// s from left to right, t from bottom to top; their images tile the trimmed domain.
   std::vector<spline::Surface> domains;
   UntrimReport report;
