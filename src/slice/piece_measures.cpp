@@ -254,16 +254,12 @@ PieceMeasures piece_measures(const std::vector<BoundaryFace>& faces, int cell, c
           const auto pts = p.points();
           for (std::size_t q = 0; q < pts.size(); q += static_cast<std::size_t>(p.dim())) a.push_back(sg * pts[q + k]);
           spline::Surface g({p.knots(0), p.knots(1)}, 1, std::move(a));
-          best = std::max(best, corner_max(g));
-          // A patch of several spans (not what untrim makes): its coefficients bound it; take
-          // that conservative bound rather than subdividing.
-          if (p.count(0) != p.orders()[0] || p.count(1) != p.orders()[1]) {
-            const auto& c = g.points();
-            best = std::max(best, *std::max_element(c.begin(), c.end()));
-            r.bbox_tight = false;
-            continue;
+          // A patch of several knot spans (untrim's sides of many Bezier pieces): its Bezier pieces.
+          const bool several = p.count(0) != p.orders()[0] || p.count(1) != p.orders()[1];
+          for (auto& b : several ? spline::bezier_pieces(g) : std::vector<spline::Surface>{std::move(g)}) {
+            best = std::max(best, corner_max(b));
+            grids.push_back(std::move(b));
           }
-          grids.push_back(std::move(g));
         }
       for (const auto& g : grids) r.bbox_tight = patch_max(g, tol, options.bbox_budget, best) && r.bbox_tight;
       r.bbox[static_cast<std::size_t>(side)][k] = sg * best;
