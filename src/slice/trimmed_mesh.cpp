@@ -300,18 +300,23 @@ vmodel::BoundaryMesh mesh_faces_impl(const std::vector<BoundaryFace>& faces, dou
       }
     hw = std::max(hw, 4.0 * lip * ptol[f]);
   }
+  // Refined to a third of the tolerance, as vmodel::mesh_boundary's estimate bounds each term of
+  // its interpolation bound by T / 3: a patch is one side of a whole monotone piece of its
+  // trimming curve (geom::untrim), so nothing but this check refines it, and the volume between
+  // the chords and a curved face (about 2/3 of the deviation times the area) stays that small.
+  const double target = tol / 3;
   for (auto& p : patches) {
     for (int round = 0;; ++round) {
       const auto dev = sample_patch(p, buf);
       mesh.rounds = std::max(mesh.rounds, round + 1);
-      if ((dev[0] <= tol && dev[1] <= tol) || round == 7) {
+      if ((dev[0] <= target && dev[1] <= target) || round == 7) {
         mesh.max_deviation = std::max(mesh.max_deviation, std::max(dev[0], dev[1]));
         break;
       }
       for (int d = 0; d < 2; ++d) {
-        if (dev[idx(d)] <= tol) continue;
+        if (dev[idx(d)] <= target) continue;
         int& n = d == 0 ? p.ns : p.nt;
-        const double factor = std::min(16.0, std::sqrt(dev[idx(d)] / tol) * 1.1);
+        const double factor = std::min(16.0, std::sqrt(dev[idx(d)] / target) * 1.1);
         const int next = std::max(n + 1, static_cast<int>(std::ceil(n * factor)));
         if (next > o.max_segments)
           throw Error("mesh: face of cell " + std::to_string(faces[idx(p.face)].cell) + ": tolerance " +

@@ -242,6 +242,34 @@ admesh_check "$tmp/bool.stl" 1 "$(json "$tmp/bool_mesh.json" 'd["volume"]')" clo
 admesh_check "$tmp/union.stl" 1 9
 admesh_check "$tmp/union_cells.stl" 3 9
 
+# A ball of radius 10 (7 cells) less the box x >= 3: one solid of genus 0 whose cut disc's boundary
+# has vertical tangents in its faces' parameters. Its volume is the cap's, pi h^2 (3 r - h) / 3
+# with h = 13, within the primitive's distance from the true sphere; the mesh's within tolerance
+# x area of the exact one; per cell the five cells the box leaves and the core, six shells.
+cat > "$tmp/ball_scene.json" <<'EOF2'
+{ "trivox": 1, "units": "mm", "properties": ["r"],
+  "cells": [
+    { "name": "ball", "primitive": {"type": "sphere", "center": [0, 0, 0], "radius": 10}, "field": {"constant": [0.3]} },
+    { "name": "cut", "primitive": {"type": "box", "min": [3, -20, -20], "max": [20, 20, 20]}, "field": {"constant": [0.6]} }
+  ],
+  "operations": [ {"op": "subtraction", "a": "ball", "b": "cut"} ] }
+EOF2
+"$trivox" build "$tmp/ball_scene.json" -o "$tmp/ball.json" > /dev/null
+"$trivox" mesh "$tmp/ball.json" -o "$tmp/ball.stl" --json > "$tmp/ball_mesh.json"
+"$trivox" mesh "$tmp/ball.json" -o "$tmp/ball_cells.stl" --cells --json > "$tmp/ball_cells.json"
+"$py" - "$tmp/ball_mesh.json" "$tmp/ball_cells.json" <<'PY'
+import json, math, sys
+b, c = (json.load(open(p)) for p in sys.argv[1:])
+assert b["trimmed"] and b["manifold"] and b["shells"] == 1 and b["euler"] == 2, b
+assert b["max_deviation"] <= b["tolerance"], b
+cap = math.pi * 13 ** 2 * (30 - 13) / 3
+assert abs(b["cell_volume"] - cap) <= 2e-3 * cap, (b["cell_volume"], cap)
+assert abs(b["volume"] - b["cell_volume"]) <= b["tolerance"] * b["area"], b
+assert c["manifold"] and c["shells"] == 6 and c["euler"] == 12, c
+PY
+admesh_check "$tmp/ball.stl" 1 "$(json "$tmp/ball_mesh.json" 'd["volume"]')" closed
+admesh_check "$tmp/ball_cells.stl" 6 "$(json "$tmp/ball_cells.json" 'd["volume"]')" closed
+
 # Per cell: every cell its own closed shell.
 "$trivox" mesh "$tmp/primitives.json" -o "$tmp/cells.stl" --cells --json > "$tmp/cells.json"
 "$py" - "$tmp/cells.json" <<'PY'
