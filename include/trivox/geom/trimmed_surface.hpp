@@ -32,8 +32,8 @@
 /// (U(s), (1 - t) v_bottom(s) + t v_top(s)), where U is the bottom and top sides' common
 /// u-polynomial. That holds when a side is a knot line or a straight edge (a line, parametrised
 /// by the other side's u(s)) or when both curves have the same u-polynomials. Otherwise the
-/// quad is split by a straight separator v = alpha + beta u through the midpoints of its left and right sides, checked to lie between the two curves (signs of
-/// Bernstein coefficients, subdivided where needed); each half is then a ruled map between a
+/// quad is split by a straight separator v = alpha + beta u through the midpoints of its left
+/// and right sides, checked to lie between the two curves (signs of Bernstein coefficients, subdivided where needed); each half is then a ruled map between a
 /// curve and the separator parametrised by that curve's u(s). Where no such separator exists
 /// the slab is halved (up to `UntrimOptions::max_splits` times). Every quad map is polynomial
 /// with a non-negative Jacobian determinant u_s (v_top - v_bottom): the patches keep the
