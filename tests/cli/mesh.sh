@@ -42,10 +42,10 @@ PY
 
 # admesh MESH.stl PARTS VOLUME [closed]: the checker's verdict. Strict: nothing for admesh to
 # repair, the volume within 1e-5. `closed`: a closed mesh (every facet connected, no edge to fix,
-# no facet to reverse or add), the volume within 1e-4. Meshes of curved trimmed faces keep the
-# narrowest slivers of the untrimming (slabs down to 1e-9 wide at a hole's vertical tangents): in
-# 32-bit floats some of their triangles lose their area, which admesh removes as degenerate (and
-# recomputes normals of others) without opening the surface.
+# no facet to reverse or add), the volume within 1e-4. Meshes of curved trimmed faces have
+# triangle-like quads (where a loop turns at a vertical tangent) whose tip triangles may lose their
+# area in 32-bit floats; admesh removes those as degenerate (and recomputes normals of others)
+# without opening the surface.
 admesh_check() {
   admesh "$1" > "$tmp/admesh.txt" 2>&1
   "$py" - "$tmp/admesh.txt" "$2" "$3" "${4:-strict}" <<'PY'
