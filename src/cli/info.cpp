@@ -2,7 +2,8 @@
 // and volume (Gauss quadrature of the Jacobian determinant, exact for polynomial cells; for the
 // trimmed pieces of Booleans the divergence theorem on their untrimmed boundary faces,
 // slice/piece_measures.hpp, or sampling where that is refused), free surfaces, properties and
-// topology counts.
+// topology counts; the integral of every property over every cell (slice/property_integrals.hpp)
+// and their totals.
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "trivox/io/model_file.hpp"
 #include "trivox/slice/locator.hpp"
 #include "trivox/slice/piece_measures.hpp"
+#include "trivox/slice/property_integrals.hpp"
 #include "trivox/slice/trim.hpp"
 #include "trivox/spline/extract.hpp"
 #include "trivox/vmodel/topology.hpp"
@@ -79,6 +81,24 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
     for (std::size_t i = 0; i < m.cells.size(); ++i)
       if (exact[i]) volumes[i] = (volumes[i] < 0 ? -1.0 : 1.0) * exact[i]->volume;
   }
+  // int rho_k dV per cell: exact for plain polynomial cells and for trimmed pieces of affine
+  // trivariates whose boundary measures succeeded; otherwise not computed, with the reason.
+  std::vector<slice::PropertyIntegrals> integrals(m.cells.size());
+  if (!m.properties.empty())
+    tbb::parallel_for(std::size_t{0}, m.cells.size(), [&](std::size_t i) {
+      if (trimmed[i] && !exact[i]) {
+        integrals[i].note = "its boundary measures were refused";
+        return;
+      }
+      try {
+        integrals[i] = slice::property_integrals(m, static_cast<int>(i));
+      } catch (const std::exception& e) {
+        integrals[i] = {};
+        integrals[i].note = e.what();
+      }
+    });
+  std::vector<double> total_integrals(m.properties.size(), 0.0);
+  bool all_integrals = !m.properties.empty(), all_exact = true;
   double total = 0;
   std::vector<double> lo(3, std::numeric_limits<double>::infinity()), hi(3, -std::numeric_limits<double>::infinity());
   auto grow = [&](const nlohmann::ordered_json& bbox) {
@@ -109,6 +129,24 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
         c["volume_note"] = "16^3 sub-boxes x 8 Gauss points, membership per point; boundary measures refused: " + refused[i];
       }
     }
+    if (!m.properties.empty()) {
+      const auto& pi = integrals[i];
+      if (pi.values.size() == m.properties.size()) {
+        nlohmann::ordered_json v = nlohmann::ordered_json::object();
+        for (std::size_t k = 0; k < m.properties.size(); ++k) {
+          v[m.properties[k]] = pi.values[k];
+          total_integrals[k] += pi.values[k];
+        }
+        c["property_integrals"] = std::move(v);
+        c["property_integrals_method"] = pi.method;
+        c["property_integrals_exact"] = pi.exact;
+        all_exact = all_exact && pi.exact;
+      } else {
+        c["property_integrals"] = nullptr;
+        c["property_integrals_note"] = "not computed: " + pi.note;
+        all_integrals = false;
+      }
+    }
     total += std::abs(volumes[i]);
     grow(c["bbox"]);
     cells.push_back(std::move(c));
@@ -125,6 +163,14 @@ nlohmann::ordered_json summarise(const vmodel::VModel& m, const std::string& fil
                         {"cells", cells},
                         {"surfaces", surfaces},
                         {"volume", total}};
+  if (all_integrals && !m.cells.empty()) {
+    nlohmann::ordered_json v = nlohmann::ordered_json::object();
+    for (std::size_t k = 0; k < m.properties.size(); ++k) v[m.properties[k]] = total_integrals[k];
+    out["property_integrals"] = std::move(v);
+    out["property_integrals_exact"] = all_exact;
+  } else {
+    out["property_integrals"] = nullptr;  // no properties, or some cell's not computed
+  }
   if (!m.cells.empty() || !m.surfaces.empty()) out["bbox"] = {lo, hi};
   else out["bbox"] = nullptr;
   const auto topo = vmodel::counts(vmodel::build_topology(m));
@@ -162,6 +208,15 @@ void print_human(const nlohmann::ordered_json& j) {
       if (c.contains("volume_method")) ++(c["volume_method"] == "boundary" ? boundary : sampled);
     if (boundary + sampled > 0)
       std::printf("trimmed cells: %d measured on their boundary faces (exact), %d sampled (approximate)\n", boundary, sampled);
+    if (!j["property_integrals"].is_null()) {
+      std::string pi;
+      for (const auto& [k, v] : j["property_integrals"].items()) pi += (pi.empty() ? "" : ", ") + k + " " + fmt(v.get<double>(), 10);
+      std::printf("property integrals (int p dV)%s: %s\n", j["property_integrals_exact"].get<bool>() ? "" : ", not exact", pi.c_str());
+    } else {
+      int missing = 0;
+      for (const auto& c : j["cells"]) missing += c.contains("property_integrals_note") ? 1 : 0;
+      if (missing > 0) std::printf("property integrals: not computed for %d cell%s (see --json)\n", missing, missing == 1 ? "" : "s");
+    }
   }
   if (!j["surfaces"].empty()) {
     std::printf("\n%-16s %-10s %-13s %s\n", "surface", "orders", "counts", "bounding box");
